@@ -1,1 +1,16 @@
-//! placeholder
+//! # railmbs-models
+//!
+//! The model description language of railmbs. A vehicle, a mechanism or a
+//! scenario is described once in a RON file; this crate reads it, resolves
+//! identifiers and expressions, and validates it with errors that name the file,
+//! the element and the RON line and column. The result is a [`Model`] (or a
+//! [`Scenario`]) that both engines — the numeric-iterative `runtime` and the
+//! symbolic `codegen` — consume.
+
+pub mod expr;
+pub mod model;
+pub mod scenario;
+
+pub use expr::{Expr, Func};
+pub use model::*;
+pub use scenario::*;

@@ -1,0 +1,237 @@
+//! The resolved, validated model: what the numeric engine (`runtime`) and the
+//! symbolic engine (`codegen`) consume. Produced by [`crate::load_model`] from a
+//! RON file; every name is resolved to an index and every numeric field is an
+//! [`Expr`] over the model's identifiers (parameters) and, where allowed, time.
+//!
+//! Conventions (see DESIGN.md): SI units; a body frame has its origin at the
+//! body's centre of mass; a joint is an ordered list of elementary
+//! transformations from the parent's body frame to the child's body frame.
+
+use crate::expr::Expr;
+use std::path::PathBuf;
+
+/// Axis of an elementary transformation or a vector component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    /// 0, 1, 2 for x, y, z.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// Kind of an elementary transformation: translation along or rotation about an
+/// axis of the current (moving) frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ElementaryKind {
+    Translation(Axis),
+    Rotation(Axis),
+}
+
+/// What drives an elementary transformation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion {
+    /// A constant over parameters only (no `t`). Metres or radians.
+    Fixed(Expr),
+    /// A generalized coordinate: index into [`Model::coordinates`].
+    Coordinate(usize),
+    /// A function of time `t` (and parameters): rheonomic. Metres or radians.
+    Time(Expr),
+}
+
+/// One elementary transformation `tx ty tz rx ry rz`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Elementary {
+    pub kind: ElementaryKind,
+    pub motion: Motion,
+}
+
+/// Which body a joint, force or cut joint refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BodyRef {
+    /// The inertial frame SC0 (body 0).
+    Ground,
+    /// Index into [`Model::bodies`].
+    Body(usize),
+}
+
+/// A rigid body with its joint to its parent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Long name (with subsystem prefix, e.g. `Bogie1.WS2`).
+    pub name: String,
+    /// kg.
+    pub mass: Expr,
+    /// Inertia tensor about the centre of mass in the body frame, kg m²:
+    /// `[ixx, iyy, izz, ixy, ixz, iyz]` (the tensor is `[[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]`;
+    /// products of inertia are the tensor's off-diagonal entries, i.e. −∫xy dm).
+    pub inertia: [Expr; 6],
+    /// The parent. Parents always come before their children in `Model::bodies`
+    /// (the loader sorts topologically), so a forward pass over bodies is a tree traversal.
+    pub parent: BodyRef,
+    /// Elementary transformations from the parent body frame to this body frame.
+    pub joint: Vec<Elementary>,
+}
+
+/// A generalized coordinate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coordinate {
+    /// Long name, used as the CSV column name.
+    pub name: String,
+    /// Index of the body whose joint holds it.
+    pub body: usize,
+    /// Index of the elementary transformation within that joint.
+    pub elementary: usize,
+    /// Initial value (m or rad), expression over parameters.
+    pub initial: Expr,
+    /// Initial velocity (m/s or rad/s), expression over parameters.
+    pub initial_velocity: Expr,
+}
+
+/// A frame fixed to a body: origin in the body frame (m) and orientation by
+/// rotations about x, then y, then z of the moving frame (rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub origin: [Expr; 3],
+    pub rotation_xyz: [Expr; 3],
+}
+
+/// A relative-pose component that a cut joint constrains, measured in frame 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Component {
+    Tx,
+    Ty,
+    Tz,
+    Rx,
+    Ry,
+    Rz,
+}
+
+/// A cut joint closing a kinematic loop: the constrained components of the
+/// pose of `frame2` on `body2` relative to `frame1` on `body1` are zero.
+/// Translational components: (r₂ − r₁)·e_k(frame 1). Rotational components:
+/// the antisymmetric part of R = A₁ᵀA₂, g_x = (R_zy − R_yz)/2 etc. (equal to the
+/// small relative rotation angle).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutJoint {
+    pub name: String,
+    pub body1: BodyRef,
+    pub frame1: Frame,
+    pub body2: BodyRef,
+    pub frame2: Frame,
+    pub constrained: Vec<Component>,
+}
+
+/// The frame in which a vector given in a model is expressed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum VectorFrame {
+    /// The inertial frame SC0.
+    Global,
+    /// The body frame of the body the element acts on.
+    Body,
+}
+
+/// Force elements of the model. The runtime computes their forces; the model
+/// only describes them. Each variant's fields are expressions over parameters
+/// (and `t` where stated).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ForceKind {
+    /// Linear bipolar spring–damper between two points (paper Sect. 3.1):
+    /// F = c (x − x0) + d ẋ + f0 along the line of the points, x the distance (m).
+    /// Positive force pulls the points together (tension).
+    Bipolar {
+        body1: BodyRef,
+        point1: [Expr; 3],
+        body2: BodyRef,
+        point2: [Expr; 3],
+        /// N/m.
+        stiffness: Expr,
+        /// N s/m.
+        damping: Expr,
+        /// N.
+        preload: Expr,
+        /// Free length, m.
+        free_length: Expr,
+    },
+    /// Generalized linear 6×6 elastic and dissipative element (paper Sect. 3.2)
+    /// between frame 1 on body 1 and frame 2 on body 2. The relative displacement
+    /// (three translations, three small rotations, in frame 1) is
+    /// δ = (A₁ᵀ(r₂ − r₁), g_rot) and the wrench on body 2, in frame 1, is
+    /// −(C δ + D δ̇ + preload); body 1 gets the reaction.
+    Linear6 {
+        body1: BodyRef,
+        frame1: Frame,
+        body2: BodyRef,
+        frame2: Frame,
+        /// Row-major 6×6, N/m, N/rad, N m/m, N m/rad.
+        stiffness: Box<[Expr; 36]>,
+        /// Row-major 6×6, damping units as stiffness per second.
+        damping: Box<[Expr; 36]>,
+        /// Static preload wrench (N, N m), in frame 1.
+        preload: [Expr; 6],
+    },
+    /// An applied force and torque on one body; expressions may depend on `t`.
+    Applied {
+        body: usize,
+        /// Point of application in the body frame, m.
+        point: [Expr; 3],
+        /// N.
+        force: [Expr; 3],
+        /// N m.
+        torque: [Expr; 3],
+        frame: VectorFrame,
+    },
+}
+
+/// A named force element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceElement {
+    /// Long name, used in output variable names.
+    pub name: String,
+    pub kind: ForceKind,
+}
+
+/// An identifier of the model: a runtime input of both engines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    pub name: String,
+    /// Default: an expression over other parameters (never `t`).
+    pub default: Expr,
+    /// Free text (units, meaning).
+    pub doc: String,
+}
+
+/// A named set of assignments applied at once ("loaded", a wedge type...).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Macro {
+    pub name: String,
+    /// (parameter index, new value expression).
+    pub assignments: Vec<(usize, Expr)>,
+}
+
+/// A resolved, validated model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    pub name: String,
+    /// The file it was loaded from, when it came from a file.
+    pub source: Option<PathBuf>,
+    pub parameters: Vec<Parameter>,
+    pub macros: Vec<Macro>,
+    /// m/s², expressions over parameters. Default (0, 0, −9.81).
+    pub gravity: [Expr; 3],
+    /// Topologically sorted: a parent precedes its children.
+    pub bodies: Vec<Body>,
+    /// In order of appearance (body order, then elementary order).
+    pub coordinates: Vec<Coordinate>,
+    pub cut_joints: Vec<CutJoint>,
+    pub forces: Vec<ForceElement>,
+}
