@@ -1,0 +1,80 @@
+//! The interface between the equations of motion and the integrators.
+//!
+//! A mechanical system with n generalized coordinates q and nc constraints:
+//!
+//! ```text
+//!     M(q, t) q̈ = f(t, q, q̇) + Gᵀ λ,      g(q, t) = 0,   G = ∂g/∂q
+//! ```
+//!
+//! with f = Q − k (applied generalized forces minus inertia/velocity terms).
+//! The integrators in [`crate::integrate`] know nothing else about the model.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Why an evaluation or a simulation failed. Always says where (time) and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A non-finite number appeared in the equations.
+    #[error("non-finite value at t = {t} s: {what}")]
+    NonFinite { t: f64, what: String },
+    /// The integrator could not continue (Newton failure at the minimum step,
+    /// step size underflow, singular iteration matrix...).
+    #[error("simulation diverged at t = {t} s: {reason}")]
+    Diverged { t: f64, reason: String },
+    /// Anything else with a message (bad settings, a force element's complaint).
+    #[error("{0}")]
+    Other(String),
+}
+
+/// A system of second-order ODEs or index-3 DAEs, as the integrators see it.
+pub trait MechanicalSystem {
+    /// Number of generalized coordinates n.
+    fn dof(&self) -> usize;
+
+    /// Number of scalar constraint equations nc (0 without closed loops).
+    fn n_constraints(&self) -> usize {
+        0
+    }
+
+    /// Mass matrix M (n×n, symmetric positive definite) and f = Q − k (n).
+    /// `mass` and `force` come sized; implementations overwrite them.
+    fn dynamics(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError>;
+
+    /// Constraint residual g (nc) and its Jacobian G = ∂g/∂q (nc×n). Called only
+    /// when `n_constraints() > 0`.
+    fn constraints(
+        &mut self,
+        _t: f64,
+        _q: &[f64],
+        _g: &mut DVector<f64>,
+        _jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), SimError> {
+        Ok(())
+    }
+
+    /// Approximate analytic Jacobians of f: `dfdq` ≈ ∂f/∂q (≈ −C) and `dfdv` ≈
+    /// ∂f/∂q̇ (≈ −D), assembled from the force elements' local Jacobians (paper
+    /// Sect. 6). Returns `Ok(false)` when the system has none, and the integrator
+    /// then uses finite differences of [`MechanicalSystem::dynamics`].
+    fn force_jacobian(
+        &mut self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        _dfdq: &mut DMatrix<f64>,
+        _dfdv: &mut DMatrix<f64>,
+    ) -> Result<bool, SimError> {
+        Ok(false)
+    }
+
+    /// Called once for every accepted step with its final state. Force elements
+    /// with state (stick anchors, friction modes) update here and only here.
+    fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) {}
+}
