@@ -1,1 +1,8 @@
+//! # railmbs-cli
+//!
+//! The command-line tools: `umsim` (run, bench, conicity, creep) and `umgen`.
+//! Each subcommand lives in its own module with its clap arguments and a `run`
+//! function; the binaries only dispatch.
 
+pub mod conicity;
+pub mod creep;

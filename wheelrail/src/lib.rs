@@ -1,1 +1,24 @@
-//! placeholder
+//! # railmbs-wheelrail
+//!
+//! Wheel–rail contact as pure functions, validated against published references
+//! (seed paper Sect. 4; reference data in `../shared/reference`):
+//!
+//! - [`profile`]: wheel and rail profiles (SIMPACK `.prw`/`.prr`, MiniProf
+//!   `.whl`/`.ban`, two-column y–z), orientation, smoothing, evaluation;
+//! - [`geometry`]: contact geometry of a wheelset on a track, one- and two-point
+//!   contact, tables over lateral shift and roll;
+//! - [`conicity`]: equivalent conicity by EN 15302;
+//! - [`hertz`]: Hertzian contact ellipse, approach, pressure;
+//! - [`creepage`]: creepages and spin from body velocities;
+//! - [`creep`]: creep-force laws (Kalker linear, Mueller, FASTSIM, FastSim_A, Polach);
+//! - [`kalker`]: Kalker's creepage coefficients;
+//! - [`elastic_rail`]: massless elastic rail with inner/outer iterations.
+
+pub mod conicity;
+pub mod creep;
+pub mod creepage;
+pub mod elastic_rail;
+pub mod geometry;
+pub mod hertz;
+pub mod kalker;
+pub mod profile;

@@ -1,1 +1,31 @@
-fn main(){}
+//! `umsim`: the railmbs simulator.
+
+use clap::{Parser, Subcommand};
+use railmbs_cli::{conicity, creep};
+
+#[derive(Parser)]
+#[command(name = "umsim", version, about = "railmbs simulator: run scenarios, benchmark engines, wheel-rail tools")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Equivalent conicity of a wheelset on a track by EN 15302 (Annex B).
+    Conicity(conicity::Args),
+    /// Creep forces for a table of contact cases.
+    Creep(creep::Args),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Conicity(a) => conicity::run(a),
+        Command::Creep(a) => creep::run(a),
+    };
+    if let Err(e) = result {
+        eprintln!("umsim: error: {e}");
+        std::process::exit(1);
+    }
+}
