@@ -1,1 +1,352 @@
-//! placeholder
+//! Compiles generated Rust source into a `cdylib` plugin, cached by content hash.
+//!
+//! The code generator hands [`build_plugin`] one Rust source string — a whole crate root with
+//! `#[no_mangle] pub extern "C" fn ...` items and no external crates, edition 2021 — and gets
+//! back the path of a compiled shared library in the plugin cache.
+//!
+//! ```no_run
+//! use railmbs_build_support::{build_plugin, BuildOptions};
+//! let src = "#[no_mangle] pub extern \"C\" fn add(a: f64, b: f64) -> f64 { a + b }";
+//! let out = build_plugin(src, &BuildOptions::new(1))?;
+//! println!("{} (cache hit: {})", out.path.display(), out.cache_hit);
+//! # Ok::<(), railmbs_build_support::BuildError>(())
+//! ```
+//!
+//! # Compiler and flags
+//!
+//! rustc is [`find_rustc`]: an explicit path, else `RUSTC`, else `rustc` on `PATH`. The command
+//! is `rustc --crate-type cdylib --edition 2021 -C opt-level=2 -C panic=abort -C debuginfo=0
+//! -C codegen-units=N --cap-lints allow` (see [`BuildOptions::flags`]); lints are capped because
+//! generated code is not written for humans, and `panic=abort` because no panic may cross the
+//! plugin boundary.
+//!
+//! # Cache
+//!
+//! The key is a BLAKE3 hash of (source, `rustc -vV` output, flags, caller's ABI version); the
+//! library is `<cache>/<prefix>railmbs_plugin_<hash><suffix>` (e.g. `librailmbs_plugin_…so`).
+//! The cache directory is [`resolve_cache_dir`]: [`BuildOptions::cache_dir`], else
+//! `RAILMBS_CACHE_DIR`, else the platform cache directory + `railmbs/plugins`.
+//!
+//! rustc writes into a fresh temporary directory inside the cache directory (so on the same
+//! filesystem), and the finished library is renamed into place: a reader sees no file or a
+//! complete one, never a partial one. Concurrent builds of the same source (two threads or
+//! two processes) are safe without a lock file: both may compile, and the later rename
+//! replaces the earlier file with an identical one (the build is deterministic: the
+//! temporary path is remapped out of the binary). On Unix a process that already loaded the
+//! earlier file keeps its mapping of the old inode; on Windows renaming over a loaded DLL
+//! fails, and the loser of the race then uses the winner's file. Cost of the race: one
+//! redundant compile, which a lock would only trade for waiting. A process killed while
+//! compiling leaves a `.tmp-build-*` directory behind that may be deleted at any time.
+//!
+//! When rustc rejects the source, the source is kept as `<cache>/failed/<hash>.rs` and rustc's
+//! stderr as `<cache>/failed/<hash>.stderr`; the error ([`BuildError::CompileFailed`]) names
+//! both and quotes the stderr, whose file paths point at the kept source.
+//!
+//! # Compile time versus run time
+//!
+//! MEASUREMENTS_PLACEHOLDER
+
+mod cache;
+mod error;
+mod rustc;
+
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+pub use cache::{CACHE_DIR_ENV, resolve_cache_dir, write_source};
+pub use error::BuildError;
+pub use rustc::{Rustc, find_rustc};
+
+/// The Rust edition generated sources are compiled with.
+pub const EDITION: &str = "2021";
+
+/// Default `-C codegen-units` (see the measurements in the crate docs).
+pub const DEFAULT_CODEGEN_UNITS: u32 = 16;
+
+/// Version of the cache-key layout; bump it when the key's meaning changes.
+const KEY_VERSION: &str = "railmbs-build-support plugin key v1";
+
+/// Flags a caller may not pass in [`BuildOptions::extra_flags`]: this crate sets them itself.
+const RESERVED_FLAGS: [&str; 6] = [
+    "-o",
+    "--out-dir",
+    "--crate-type",
+    "--crate-name",
+    "--emit",
+    "--remap-path-prefix",
+];
+
+/// How to build a plugin.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BuildOptions {
+    /// ABI version of the plugin interface, chosen by the caller; part of the cache key, so a
+    /// new ABI never picks up a library built for an old one.
+    pub abi_version: u32,
+    /// `-C opt-level`: 0, 1, 2 or 3. Default 2.
+    pub opt_level: u8,
+    /// `-C codegen-units` (at least 1). Default [`DEFAULT_CODEGEN_UNITS`].
+    pub codegen_units: u32,
+    /// Further rustc arguments appended after the standard ones (e.g. `-C target-cpu=native`);
+    /// part of the cache key. Output-location and crate-type flags are refused.
+    pub extra_flags: Vec<String>,
+    /// Cache directory; `None` uses [`resolve_cache_dir`]'s default chain.
+    pub cache_dir: Option<PathBuf>,
+    /// rustc to run; `None` uses [`find_rustc`]'s default chain (`RUSTC`, then `PATH`).
+    pub rustc: Option<PathBuf>,
+}
+
+impl BuildOptions {
+    /// Default options for ABI version `abi_version`.
+    pub fn new(abi_version: u32) -> Self {
+        BuildOptions {
+            abi_version,
+            opt_level: 2,
+            codegen_units: DEFAULT_CODEGEN_UNITS,
+            extra_flags: Vec::new(),
+            cache_dir: None,
+            rustc: None,
+        }
+    }
+
+    /// Sets [`Self::cache_dir`].
+    pub fn with_cache_dir(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.cache_dir = Some(dir.into());
+        self
+    }
+
+    /// Checks the option values.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        if self.opt_level > 3 {
+            return Err(BuildError::InvalidOption(format!(
+                "opt_level must be 0, 1, 2 or 3, got {}",
+                self.opt_level
+            )));
+        }
+        if self.codegen_units == 0 {
+            return Err(BuildError::InvalidOption(
+                "codegen_units must be at least 1, got 0".to_owned(),
+            ));
+        }
+        for f in &self.extra_flags {
+            let name = f.split('=').next().unwrap_or(f);
+            if RESERVED_FLAGS.contains(&name) || (f.starts_with("-o") && f.len() > 2) {
+                return Err(BuildError::InvalidOption(format!(
+                    "extra rustc flag {f:?} is not allowed: build-support sets {name} itself"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The rustc arguments that determine the output (everything but paths and crate name);
+    /// these are hashed into the cache key.
+    pub fn flags(&self) -> Vec<String> {
+        let mut v: Vec<String> = [
+            "--crate-type",
+            "cdylib",
+            "--edition",
+            EDITION,
+            "-C",
+            &format!("opt-level={}", self.opt_level),
+            "-C",
+            "panic=abort",
+            "-C",
+            "debuginfo=0",
+            "-C",
+            &format!("codegen-units={}", self.codegen_units),
+            "--cap-lints",
+            "allow",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        v.extend(self.extra_flags.iter().cloned());
+        v
+    }
+}
+
+/// A compiled plugin.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BuildOutput {
+    /// The shared library in the cache.
+    pub path: PathBuf,
+    /// The cache key (BLAKE3, 64 hex digits).
+    pub hash: String,
+    /// `true` if the library was already in the cache and nothing was compiled.
+    pub cache_hit: bool,
+    /// Wall-clock time rustc took (`None` on a cache hit).
+    pub compile_time: Option<Duration>,
+    /// The rustc used (for the key; also on a cache hit).
+    pub rustc: Rustc,
+}
+
+/// The cache key of `source` built with `flags` by the rustc whose `rustc -vV` is
+/// `rustc_version`, for ABI `abi_version`: BLAKE3 over length-prefixed fields, 64 hex digits.
+pub fn cache_key(source: &str, rustc_version: &str, flags: &[String], abi_version: u32) -> String {
+    let mut h = blake3::Hasher::new();
+    let mut field = |bytes: &[u8]| {
+        h.update(&(bytes.len() as u64).to_le_bytes());
+        h.update(bytes);
+    };
+    field(KEY_VERSION.as_bytes());
+    field(&abi_version.to_le_bytes());
+    field(rustc_version.as_bytes());
+    field(&(flags.len() as u64).to_le_bytes());
+    for f in flags {
+        field(f.as_bytes());
+    }
+    field(source.as_bytes());
+    h.finalize().to_hex().to_string()
+}
+
+/// Compiles `source` into a `cdylib` in the cache, or returns the cached one.
+///
+/// See the crate docs for the flags, the cache layout and concurrency. Errors: no rustc
+/// ([`BuildError::RustcNotFound`]), rejected source ([`BuildError::CompileFailed`], naming the
+/// kept source), I/O ([`BuildError::Io`], naming the path), bad options.
+pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput, BuildError> {
+    options.validate()?;
+    let rustc = find_rustc(options.rustc.as_deref())?;
+    let cache = resolve_cache_dir(options.cache_dir.as_deref())?;
+    let flags = options.flags();
+    let hash = cache_key(source, &rustc.version, &flags, options.abi_version);
+    let crate_name = format!("railmbs_plugin_{hash}");
+    let lib_name = format!(
+        "{}{crate_name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    );
+    let dest = cache.join(&lib_name);
+    if dest.is_file() {
+        return Ok(BuildOutput {
+            path: dest,
+            hash,
+            cache_hit: true,
+            compile_time: None,
+            rustc,
+        });
+    }
+
+    cache::create_dir_all(&cache)?;
+    let tmp = tempfile::Builder::new()
+        .prefix(".tmp-build-")
+        .tempdir_in(&cache)
+        .map_err(|e| BuildError::io(&cache, e))?;
+    let src_name = format!("{hash}.rs");
+    let src_path = tmp.path().join(&src_name);
+    std::fs::write(&src_path, source).map_err(|e| BuildError::io(&src_path, e))?;
+    let failed_dir = cache.join("failed");
+    let out_path = tmp.path().join(&lib_name);
+
+    let mut cmd = Command::new(&rustc.path);
+    cmd.args(&flags)
+        .arg("--crate-name")
+        .arg(&crate_name)
+        .arg("-o")
+        .arg(&out_path);
+    // Remap the temporary directory to `failed/`: diagnostics then name the kept source, and
+    // the library does not embed a random path (deterministic output). rustc splits the
+    // argument at its last '=', so a target path containing '=' cannot be remapped.
+    if !failed_dir.as_os_str().to_string_lossy().contains('=') {
+        let mut remap = OsString::from(tmp.path());
+        remap.push("=");
+        remap.push(&failed_dir);
+        cmd.arg("--remap-path-prefix").arg(remap);
+    }
+    cmd.arg(&src_path)
+        .current_dir(tmp.path())
+        .stdin(Stdio::null());
+
+    let start = Instant::now();
+    let out = cmd.output().map_err(|e| BuildError::RustcNotFound {
+        reason: format!("`{}` could not be started: {e}", rustc.path.display()),
+    })?;
+    let compile_time = start.elapsed();
+
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        cache::create_dir_all(&failed_dir)?;
+        let kept = failed_dir.join(&src_name);
+        std::fs::rename(&src_path, &kept).map_err(|e| BuildError::io(&kept, e))?;
+        let stderr_path = failed_dir.join(format!("{hash}.stderr"));
+        cache::write_atomic(&stderr_path, stderr.as_bytes())?;
+        return Err(BuildError::CompileFailed {
+            source_path: kept,
+            stderr_path,
+            status: out.status.to_string(),
+            stderr,
+        });
+    }
+    if !out_path.is_file() {
+        return Err(BuildError::io(
+            &out_path,
+            std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "rustc reported success but wrote no library",
+            ),
+        ));
+    }
+    if let Err(e) = std::fs::rename(&out_path, &dest) {
+        // Lost a race against a concurrent build of the same key (e.g. Windows refuses to
+        // replace a loaded DLL): the file in place is equivalent.
+        if !dest.is_file() {
+            return Err(BuildError::io(&dest, e));
+        }
+    }
+    Ok(BuildOutput {
+        path: dest,
+        hash,
+        cache_hit: false,
+        compile_time: Some(compile_time),
+        rustc,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn key_depends_on_every_input() {
+        let f = BuildOptions::new(1).flags();
+        let base = cache_key("src", "rustc 1", &f, 1);
+        assert_eq!(base.len(), 64);
+        assert_eq!(base, cache_key("src", "rustc 1", &f, 1));
+        assert_ne!(base, cache_key("src2", "rustc 1", &f, 1));
+        assert_ne!(base, cache_key("src", "rustc 2", &f, 1));
+        assert_ne!(base, cache_key("src", "rustc 1", &f, 2));
+        assert_ne!(base, cache_key("src", "rustc 1", &f[1..], 1));
+        // Length prefixes: moving a byte between fields changes the key.
+        let a = cache_key("xsrc", "rustc 1", &f, 1);
+        let b = cache_key("src", "rustc 1x", &f, 1);
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn invalid_options_are_named() {
+        let mut o = BuildOptions::new(1);
+        o.opt_level = 4;
+        assert!(o.validate().unwrap_err().to_string().contains("opt_level"));
+        let mut o = BuildOptions::new(1);
+        o.codegen_units = 0;
+        assert!(
+            o.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("codegen_units")
+        );
+        for bad in ["-o", "-ofoo", "--out-dir=x", "--crate-type", "--emit=asm"] {
+            let mut o = BuildOptions::new(1);
+            o.extra_flags = vec![bad.to_owned()];
+            assert!(
+                matches!(o.validate(), Err(BuildError::InvalidOption(_))),
+                "{bad}"
+            );
+        }
+        let mut o = BuildOptions::new(1);
+        o.extra_flags = vec!["-C".into(), "target-cpu=native".into()];
+        o.validate().unwrap();
+    }
+}
