@@ -9,8 +9,10 @@
 
 pub mod expr;
 pub mod model;
+pub mod parser;
 pub mod scenario;
 
 pub use expr::{Expr, Func};
 pub use model::*;
+pub use parser::{ParseError, ParseErrorKind, parse_expr, parse_expr_with};
 pub use scenario::*;

@@ -1,0 +1,223 @@
+//! Expressions: parsing, evaluation against hand-computed values, time
+//! derivatives against central differences, display round trip.
+
+use proptest::prelude::*;
+use railmbs_models::{Expr, Func, ParseErrorKind, parse_expr};
+use std::f64::consts::PI;
+
+fn names() -> Vec<String> {
+    ["a", "b", "WS1.r0", "k_2"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+}
+
+const P: [f64; 4] = [2.0, 3.0, 0.46, 0.5];
+
+fn ev(text: &str, t: f64) -> f64 {
+    parse_expr(text, &names(), true)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .eval(&P, t)
+}
+
+#[test]
+fn evaluates_hand_computed_values() {
+    // Values computed by hand from a = 2, b = 3, WS1.r0 = 0.46, k_2 = 0.5.
+    let cases: &[(&str, f64)] = &[
+        ("1", 1.0),
+        ("1.5", 1.5),
+        ("1e-3", 1e-3),
+        ("2.5E+2", 250.0),
+        (".5", 0.5),
+        ("a + b * 2", 8.0),
+        ("(a + b) * 2", 10.0),
+        ("a - b - 1", -2.0),
+        ("a / b / 2", 2.0 / 3.0 / 2.0),
+        ("2^3^2", 512.0),
+        ("-a^2", -4.0),
+        ("(-a)^2", 4.0),
+        ("2^-1", 0.5),
+        ("-2*-b", 6.0),
+        ("+a", 2.0),
+        ("WS1.r0*2", 0.92),
+        ("k_2", 0.5),
+        ("sqrt(16) + abs(-3) + exp(0) + ln(1)", 8.0),
+        ("sin(pi/2) + cos(0) + tan(0) + atan(1)*4", 2.0 + PI),
+        ("  a*( b -1 ) ", 4.0),
+    ];
+    for (text, want) in cases {
+        let got = ev(text, 0.0);
+        // Each case involves at most a handful of correctly rounded operations.
+        assert!(
+            (got - want).abs() <= 1e-14 * want.abs().max(1.0),
+            "{text}: got {got}, want {want}"
+        );
+    }
+    assert_eq!(ev("t*a", 1.5), 3.0);
+}
+
+#[test]
+fn structure_of_precedence() {
+    let e = parse_expr("-x^2", &["x".to_string()], false).unwrap();
+    assert_eq!(
+        e,
+        Expr::Neg(Box::new(Expr::Pow(
+            Box::new(Expr::Param(0)),
+            Box::new(Expr::Num(2.0))
+        )))
+    );
+    assert_eq!(
+        parse_expr("pi", &[], false).unwrap(),
+        Expr::Num(PI),
+        "pi is a constant"
+    );
+}
+
+#[test]
+fn params_used_and_has_time() {
+    let e = parse_expr("b*a + sin(b*t) + k_2", &names(), true).unwrap();
+    assert_eq!(e.params_used(), vec![0, 1, 3]);
+    assert!(e.has_time());
+    assert!(!parse_expr("a*b", &names(), true).unwrap().has_time());
+    assert!(Expr::num(0.0).is_zero());
+    assert!(!Expr::num(1.0).is_zero());
+    assert!(!parse_expr("0*a", &names(), false).unwrap().is_zero());
+}
+
+#[test]
+fn parse_errors_give_text_column_and_expectation() {
+    let e = parse_expr("a + * b", &names(), false).unwrap_err();
+    assert_eq!(e.column, 5);
+    let msg = e.to_string();
+    assert!(msg.contains("\"a + * b\""), "{msg}");
+    assert!(msg.contains("column 5"), "{msg}");
+    assert!(msg.contains("expected a number, an identifier"), "{msg}");
+
+    let e = parse_expr("(a + b", &names(), false).unwrap_err();
+    assert_eq!(e.column, 7);
+    assert!(e.to_string().contains("expected ')'"), "{e}");
+
+    let e = parse_expr("2*zz", &names(), false).unwrap_err();
+    assert_eq!(e.column, 3);
+    assert_eq!(e.kind, ParseErrorKind::UnknownIdentifier("zz".into()));
+
+    let e = parse_expr("a*sin(t)", &names(), false).unwrap_err();
+    assert_eq!(e.kind, ParseErrorKind::TimeNotAllowed);
+    assert_eq!(e.column, 7);
+
+    for bad in [
+        "", "a b", "2a", "sin a", "1e", "a.", "a +", "()", "1..2", "a)",
+    ] {
+        assert!(
+            parse_expr(bad, &names(), true).is_err(),
+            "\"{bad}\" should not parse"
+        );
+    }
+}
+
+/// Central difference of `e` at `t`: error O(h²·f‴); with h = 1e-5 and the
+/// smooth functions below (|f‴| ≲ 10²) truncation is ~1e-8 and rounding
+/// ~1e-16/1e-5 = 1e-11, so 1e-6 relative is a safe bound.
+fn central_difference(e: &Expr, t: f64) -> f64 {
+    let h = 1e-5;
+    (e.eval(&P, t + h) - e.eval(&P, t - h)) / (2.0 * h)
+}
+
+#[test]
+fn time_derivative_matches_central_differences() {
+    let texts = [
+        "a*t^2 + b*t + 1",
+        "sin(2*pi*b*t) * exp(-t)",
+        "cos(a*t)/(1 + t^2)",
+        "tan(0.3*t) + sqrt(1 + t) + ln(2 + t)",
+        "atan(a*t) - abs(t - 5)",
+        "(1 + t)^(a*t)",
+        "-(t^3)/b + 2^t",
+        "WS1.r0 * a",
+    ];
+    for text in texts {
+        let e = parse_expr(text, &names(), true).unwrap();
+        let d = e.time_derivative();
+        for &t in &[0.1, 0.7, 1.3, 2.9] {
+            let want = central_difference(&e, t);
+            let got = d.eval(&P, t);
+            assert!(
+                (got - want).abs() <= 1e-6 * want.abs().max(1.0),
+                "d/dt {text} at t = {t}: got {got}, central difference {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn time_derivative_simplifies_trivial_terms() {
+    let n = names();
+    let d = |s: &str| parse_expr(s, &n, true).unwrap().time_derivative();
+    assert!(d("a*b + sin(a)").is_zero());
+    assert_eq!(d("t"), Expr::Num(1.0));
+    assert_eq!(d("a*t"), Expr::Param(0));
+    assert_eq!(d("t + b"), Expr::Num(1.0));
+    assert_eq!(d("-t"), Expr::Neg(Box::new(Expr::Num(1.0))));
+}
+
+#[test]
+fn display_round_trips() {
+    let n = names();
+    for text in [
+        "a - (b - 1)",
+        "a/(b/2)",
+        "-a^2",
+        "(-a)^2",
+        "2^3^2",
+        "(2^3)^2",
+        "a*(-b)",
+        "-(-a)",
+        "sin(a + t)*WS1.r0",
+        "1e-7 + 0.1",
+        "-(a*b)",
+        "a^(-1)",
+    ] {
+        let e = parse_expr(text, &n, true).unwrap();
+        let shown = e.display(&n);
+        let back = parse_expr(&shown, &n, true).unwrap_or_else(|err| panic!("{shown}: {err}"));
+        assert_eq!(back, e, "{text} displayed as {shown}");
+    }
+    let e = Expr::Add(Box::new(Expr::Num(-2.5)), Box::new(Expr::Num(1e300)));
+    let back = parse_expr(&e.display(&n), &n, true).unwrap();
+    assert_eq!(back.eval(&P, 0.0), e.eval(&P, 0.0));
+}
+
+fn arb_expr() -> impl Strategy<Value = Expr> {
+    let leaf = prop_oneof![
+        (-1e3f64..1e3).prop_map(Expr::Num),
+        (0usize..4).prop_map(Expr::Param),
+        Just(Expr::Time),
+    ];
+    leaf.prop_recursive(5, 40, 2, |inner| {
+        let b = |e: Expr| Box::new(e);
+        prop_oneof![
+            inner.clone().prop_map(move |a| Expr::Neg(b(a))),
+            (inner.clone(), inner.clone()).prop_map(move |(x, y)| Expr::Add(b(x), b(y))),
+            (inner.clone(), inner.clone()).prop_map(move |(x, y)| Expr::Sub(b(x), b(y))),
+            (inner.clone(), inner.clone()).prop_map(move |(x, y)| Expr::Mul(b(x), b(y))),
+            (inner.clone(), inner.clone()).prop_map(move |(x, y)| Expr::Div(b(x), b(y))),
+            (inner.clone(), inner.clone()).prop_map(move |(x, y)| Expr::Pow(b(x), b(y))),
+            (0usize..8, inner).prop_map(move |(f, x)| Expr::Call(Func::ALL[f], b(x))),
+        ]
+    })
+}
+
+fn same_value(x: f64, y: f64) -> bool {
+    x == y || (x.is_nan() && y.is_nan())
+}
+
+proptest! {
+    #[test]
+    fn random_trees_display_and_reparse_to_equal_values(e in arb_expr(), t in -3.0f64..3.0) {
+        let n = names();
+        let shown = e.display(&n);
+        let back = parse_expr(&shown, &n, true).map_err(|err| TestCaseError::fail(format!("{shown}: {err}")))?;
+        // The same operations in the same order: bitwise equal values.
+        prop_assert!(same_value(back.eval(&P, t), e.eval(&P, t)), "{} -> {}", shown, back.display(&n));
+    }
+}
