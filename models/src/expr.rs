@@ -355,7 +355,7 @@ fn write_number(x: f64, out: &mut String) {
 
 fn neg(a: Expr) -> Expr {
     match a {
-        Expr::Num(x) if x == 0.0 => Expr::Num(0.0),
+        Expr::Num(0.0) => Expr::Num(0.0),
         Expr::Neg(inner) => *inner,
         a => Expr::Neg(Box::new(a)),
     }

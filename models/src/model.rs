@@ -143,6 +143,9 @@ pub enum VectorFrame {
 /// Force elements of the model. The runtime computes their forces; the model
 /// only describes them. Each variant's fields are expressions over parameters
 /// (and `t` where stated).
+// The variants' sizes differ, but a model holds few force elements and the
+// layout is a contract shared by both engines.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum ForceKind {
     /// Linear bipolar spring–damper between two points (paper Sect. 3.1):
