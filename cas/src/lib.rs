@@ -1,1 +1,89 @@
-//! placeholder
+//! # railmbs-cas — the computer-algebra system of railmbs
+//!
+//! The code generator derives the equations of motion of a multibody system (recursive
+//! kinematics over products of elementary rotations, mass matrices by the composite-body
+//! method, Jacobians) with this crate, then compiles all outputs together into straight-line
+//! code ([`Program`]) that it emits as Rust.
+//!
+//! ## Design
+//!
+//! * **Arena with hash-consing.** A [`Context`] owns every node; an [`ExprId`] is a `u32` index
+//!   (`Copy`). Structurally equal nodes are stored once (open-addressing table of ids, hashed
+//!   once on creation), so equal subexpressions are one node and "is it the same expression"
+//!   is an id comparison. The arena is append-only: operands always have smaller ids than
+//!   their users, so ascending id order is a topological order — traversals are iterative and
+//!   cannot overflow the stack.
+//! * **Node kinds** ([`Node`]): numbers (`f64`), symbols ([`Symbol`]: a [`SymbolKind`] —
+//!   coordinate `q`, velocity `v`, parameter `p`, input `u`, time `t` — and an index, so
+//!   generated code maps them to input arrays), n-ary sums `constant + Σ cᵢ·bᵢ` with numeric
+//!   coefficients, n-ary products `Π bᵢ^kᵢ` with integer exponents, the functions of [`Func`]
+//!   (sin, cos, tan, sqrt, exp, ln, abs) and `atan2`.
+//!   Division is a product with exponent −1 (no separate node), an integer power is a
+//!   one-factor product, negation is the coefficient −1 (a "scaled term" `c·b` is a one-term
+//!   sum). Operands of sums and products are sorted by id, so commutative forms are equal nodes.
+//! * **Numbers** are `f64`. Folding is plain f64 arithmetic: exact whenever the result is
+//!   representable (integers, dyadic fractions such as 0.5, which is what model coefficients
+//!   and the derivatives of integer powers produce), otherwise correctly rounded per operation.
+//!   Functions of numbers are folded only when the result is finite (`ln(-1)` stays symbolic).
+//!   Non-finite values are never produced silently: [`Context::eval`], [`Program::eval`]
+//!   report them as [`CasError::NonFinite`].
+//!
+//! ## What the simplifier does on construction
+//!
+//! All rules are local and cheap (cost linear in the operand count of the node being built,
+//! up to sorting); there is no expansion by default ([`Context::expand`] exists for small
+//! expressions).
+//!
+//! * constant folding of sums, products and functions of numbers;
+//! * identities `x + 0`, `x·1`, `x·0 = 0`, `x⁰ = 1`, `x¹ = x`;
+//! * flattening of nested sums and products; numeric factors of products are pulled out
+//!   (`2x·3y = 6·(x·y)`), and a number times a sum is distributed (`2·(x + y) = 2x + 2y`);
+//! * like terms `c₁x + c₂x = (c₁+c₂)x` and like factors `x·x = x²`, `x·x⁻¹ = 1` (so `x/x = 1`,
+//!   as every CAS does, ignoring x = 0);
+//! * `sin(−x) = −sin x`, `cos(−x) = cos x`, `tan(−x) = −tan x`, `|−x| = |x|`, `||x|| = |x|`,
+//!   using a canonical sign of the argument ([`Context::is_negative_form`]), so `sin(a−b)` and
+//!   `sin(b−a)` share one node;
+//! * `√(x²) = |x|`, `(√x)^k = x^(k/2)·(√x)^(k mod 2)`, `exp(ln x) = x`, `ln(exp x) = x`;
+//! * **sin² + cos² = 1** inside one sum: two terms `c·sin(u)^k·P` and `c·cos(u)^m·P'` with the
+//!   same coefficient `c`, `k, m ≥ 2`, and the same remaining monomial
+//!   `sin(u)^(k−2)·P = cos(u)^(m−2)·P'` are replaced by `c·(that remainder)`, repeatedly (the
+//!   result may merge with other terms). This is what products of elementary rotation
+//!   matrices create: `R_z(a)ᵀR_z(a)` simplifies to the identity, `m·l²·sin²q + m·l²·cos²q` to
+//!   `m·l²`.
+//!
+//! It does **not**: expand products of sums, factor, find common denominators, apply angle
+//! addition formulas, combine `c₁·sin²u·P + c₂·cos²u·P` with `c₁ ≠ c₂`, recognise
+//! `1 − sin²u = cos²u`, or simplify `√` of non-squares. Two mathematically equal expressions
+//! may therefore be different nodes; numeric equality is checked by evaluation.
+//!
+//! ## Calculus, substitution, evaluation
+//!
+//! [`Context::diff`] differentiates with respect to a symbol, memoized per variable for the
+//! life of the context ([`Context::jacobian`] for many at once). [`Context::subs`] and
+//! [`Substitution`] replace symbols by expressions (memoized). [`Context::eval`] is the
+//! reference interpreter, with symbol values per kind in [`Values`].
+//!
+//! ## Straight-line code
+//!
+//! [`Program::compile`] lowers a list of outputs together into instructions
+//! `t_k = op(operands)` (see [`Program`] for the lowering rules: shared nodes once, value
+//! numbering, powers by squaring with shared `x²`, negation folded into subtraction, one
+//! division per product). [`Context::tree_op_counts`] gives the operation count of the
+//! unshared tree form (saturating `u128`), [`Program::op_counts`] that of the program — the
+//! "before / after CSE" numbers. [`Program::eval`] interprets the program.
+//!
+//! For code generation of large programs, [`Program::last_uses`] gives liveness of
+//! temporaries and [`Program::split`] cuts the program into chunks of bounded size that pass
+//! the temporaries they share through a scratch array (slots reused when dead);
+//! [`SplitProgram::eval`] checks a split by running each chunk in isolation.
+//! [`Program::sin_cos_pairs`] lists sin/cos of the same argument for `sin_cos` fusion.
+
+mod calculus;
+mod eval;
+mod graph;
+mod program;
+
+pub use calculus::Substitution;
+pub use eval::{CasError, Values};
+pub use graph::{Context, Display, ExprId, Func, Node, ONE, Symbol, SymbolKind, ZERO};
+pub use program::{Chunk, Instr, OpCounts, Operand, Program, SplitProgram};

@@ -1,0 +1,656 @@
+//! Common-subexpression elimination into straight-line code, operation counts, and splitting
+//! of the code into chunks of bounded size.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::ops::Range;
+
+use crate::eval::{CasError, Values};
+use crate::graph::{Context, ExprId, Func, Node, Symbol};
+
+/// An instruction operand: a temporary (the result of instruction `k`), a symbol (an input), or
+/// a constant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Operand {
+    /// Result of instruction `k` of the program.
+    Tmp(u32),
+    /// An input value.
+    Sym(Symbol),
+    /// A constant.
+    Const(f64),
+}
+
+impl fmt::Display for Operand {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Operand::Tmp(k) => write!(f, "t{k}"),
+            Operand::Sym(s) => write!(f, "{s}"),
+            Operand::Const(c) => write!(f, "{c:?}"),
+        }
+    }
+}
+
+/// One instruction `tmp_k = op(args)`; `k` is its position in [`Program::instrs`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Instr {
+    /// `a + b`.
+    Add(Operand, Operand),
+    /// `a − b`.
+    Sub(Operand, Operand),
+    /// `a · b`.
+    Mul(Operand, Operand),
+    /// `a / b`.
+    Div(Operand, Operand),
+    /// `−a`.
+    Neg(Operand),
+    /// `f(a)`.
+    Call(Func, Operand),
+    /// `atan2(y, x)`.
+    Atan2(Operand, Operand),
+}
+
+impl Instr {
+    /// Calls `f` on each operand.
+    pub fn for_each_operand(&self, mut f: impl FnMut(Operand)) {
+        match *self {
+            Instr::Add(a, b)
+            | Instr::Sub(a, b)
+            | Instr::Mul(a, b)
+            | Instr::Div(a, b)
+            | Instr::Atan2(a, b) => {
+                f(a);
+                f(b)
+            }
+            Instr::Neg(a) | Instr::Call(_, a) => f(a),
+        }
+    }
+
+    fn counts(&self) -> OpCounts {
+        let mut c = OpCounts::default();
+        match self {
+            Instr::Add(..) | Instr::Sub(..) | Instr::Neg(_) => c.adds = 1,
+            Instr::Mul(..) => c.muls = 1,
+            Instr::Div(..) => c.divs = 1,
+            Instr::Call(..) | Instr::Atan2(..) => c.calls = 1,
+        }
+        c
+    }
+
+    fn apply(&self, get: impl Fn(Operand) -> Result<f64, CasError>) -> Result<f64, CasError> {
+        Ok(match *self {
+            Instr::Add(a, b) => get(a)? + get(b)?,
+            Instr::Sub(a, b) => get(a)? - get(b)?,
+            Instr::Mul(a, b) => get(a)? * get(b)?,
+            Instr::Div(a, b) => get(a)? / get(b)?,
+            Instr::Neg(a) => -get(a)?,
+            Instr::Call(f, a) => f.apply(get(a)?),
+            Instr::Atan2(y, x) => get(y)?.atan2(get(x)?),
+        })
+    }
+}
+
+/// Operation counts. `adds` counts additions, subtractions and negations; `calls` counts
+/// elementary-function calls (sin, cos, tan, sqrt, exp, ln, abs, atan2). Saturating `u128`, so
+/// the (possibly astronomically large) count of the unshared tree form cannot overflow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCounts {
+    /// Additions, subtractions, negations.
+    pub adds: u128,
+    /// Multiplications.
+    pub muls: u128,
+    /// Divisions.
+    pub divs: u128,
+    /// Function calls.
+    pub calls: u128,
+}
+
+impl OpCounts {
+    /// Sum of all operations.
+    pub fn total(&self) -> u128 {
+        self.adds
+            .saturating_add(self.muls)
+            .saturating_add(self.divs)
+            .saturating_add(self.calls)
+    }
+
+    fn plus(self, o: OpCounts) -> OpCounts {
+        OpCounts {
+            adds: self.adds.saturating_add(o.adds),
+            muls: self.muls.saturating_add(o.muls),
+            divs: self.divs.saturating_add(o.divs),
+            calls: self.calls.saturating_add(o.calls),
+        }
+    }
+}
+
+impl fmt::Display for OpCounts {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ops ({} add/sub/neg, {} mul, {} div, {} calls)",
+            self.total(),
+            self.adds,
+            self.muls,
+            self.divs,
+            self.calls
+        )
+    }
+}
+
+/// Hashable form of an operand for value numbering.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum OpKey {
+    Tmp(u32),
+    Sym(Symbol),
+    Const(u64),
+}
+
+fn key(o: Operand) -> OpKey {
+    match o {
+        Operand::Tmp(k) => OpKey::Tmp(k),
+        Operand::Sym(s) => OpKey::Sym(s),
+        Operand::Const(c) => OpKey::Const(c.to_bits()),
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum InstrKey {
+    Add(OpKey, OpKey),
+    Sub(OpKey, OpKey),
+    Mul(OpKey, OpKey),
+    Div(OpKey, OpKey),
+    Neg(OpKey),
+    Call(Func, OpKey),
+    Atan2(OpKey, OpKey),
+}
+
+/// Emits instructions; with `share`, equal instructions (commutative operands ordered) and equal
+/// integer powers are emitted once.
+struct Builder {
+    instrs: Vec<Instr>,
+    share: bool,
+    vn: HashMap<InstrKey, u32>,
+    pows: HashMap<(ExprId, u32), Operand>,
+}
+
+impl Builder {
+    fn new(share: bool) -> Self {
+        Builder {
+            instrs: Vec::new(),
+            share,
+            vn: HashMap::new(),
+            pows: HashMap::new(),
+        }
+    }
+
+    fn emit(&mut self, i: Instr) -> Operand {
+        let i = match i {
+            Instr::Add(a, b) if key(b) < key(a) => Instr::Add(b, a),
+            Instr::Mul(a, b) if key(b) < key(a) => Instr::Mul(b, a),
+            other => other,
+        };
+        let k = self.instrs.len() as u32;
+        if self.share {
+            let ik = match i {
+                Instr::Add(a, b) => InstrKey::Add(key(a), key(b)),
+                Instr::Sub(a, b) => InstrKey::Sub(key(a), key(b)),
+                Instr::Mul(a, b) => InstrKey::Mul(key(a), key(b)),
+                Instr::Div(a, b) => InstrKey::Div(key(a), key(b)),
+                Instr::Neg(a) => InstrKey::Neg(key(a)),
+                Instr::Call(f, a) => InstrKey::Call(f, key(a)),
+                Instr::Atan2(a, b) => InstrKey::Atan2(key(a), key(b)),
+            };
+            if let Some(&t) = self.vn.get(&ik) {
+                return Operand::Tmp(t);
+            }
+            self.vn.insert(ik, k);
+        }
+        self.instrs.push(i);
+        Operand::Tmp(k)
+    }
+
+    /// `t^n` (n ≥ 1) by binary powering: n even → (t^(n/2))², n odd → t^(n−1)·t.
+    fn pow(&mut self, b: ExprId, t: Operand, n: u32) -> Operand {
+        if n == 1 {
+            return t;
+        }
+        if self.share
+            && let Some(&p) = self.pows.get(&(b, n))
+        {
+            return p;
+        }
+        let r = if n.is_multiple_of(2) {
+            let h = self.pow(b, t, n / 2);
+            self.emit(Instr::Mul(h, h))
+        } else {
+            let h = self.pow(b, t, n - 1);
+            self.emit(Instr::Mul(h, t))
+        };
+        if self.share {
+            self.pows.insert((b, n), r);
+        }
+        r
+    }
+
+    /// Lowers one DAG node whose operands are already available through `op`.
+    fn lower(&mut self, node: &Node, op: impl Fn(ExprId) -> Operand) -> Operand {
+        match node {
+            Node::Num(v) => Operand::Const(*v),
+            Node::Sym(s) => Operand::Sym(*s),
+            Node::Add { constant, terms } => self.lower_sum(*constant, terms, op),
+            Node::Mul { factors } => {
+                let mut num: Option<Operand> = None;
+                let mut den: Option<Operand> = None;
+                for &(b, k) in factors.iter() {
+                    let p = self.pow(b, op(b), k.unsigned_abs());
+                    let acc = if k > 0 { &mut num } else { &mut den };
+                    *acc = Some(match *acc {
+                        None => p,
+                        Some(a) => self.emit(Instr::Mul(a, p)),
+                    });
+                }
+                match (num, den) {
+                    (Some(n), None) => n,
+                    (Some(n), Some(d)) => self.emit(Instr::Div(n, d)),
+                    (None, Some(d)) => self.emit(Instr::Div(Operand::Const(1.0), d)),
+                    (None, None) => Operand::Const(1.0),
+                }
+            }
+            Node::Call(f, a) => self.emit(Instr::Call(*f, op(*a))),
+            Node::Atan2(y, x) => self.emit(Instr::Atan2(op(*y), op(*x))),
+        }
+    }
+
+    /// `constant + Σ c·t` with negation folded into subtractions: positive terms are added
+    /// first, then the constant, then negative terms subtracted. With no positive part, a term
+    /// with |c| ≠ 1 takes the sign into its multiplication; only a sum of unit-negative terms
+    /// needs an explicit negation.
+    fn lower_sum(
+        &mut self,
+        constant: f64,
+        terms: &[(ExprId, f64)],
+        op: impl Fn(ExprId) -> Operand,
+    ) -> Operand {
+        let scaled = |s: &mut Self, t: Operand, m: f64| {
+            if m == 1.0 {
+                t
+            } else {
+                s.emit(Instr::Mul(Operand::Const(m), t))
+            }
+        };
+        let mut acc: Option<Operand> = None;
+        for &(b, c) in terms.iter().filter(|t| t.1 > 0.0) {
+            let v = scaled(self, op(b), c);
+            acc = Some(match acc {
+                None => v,
+                Some(a) => self.emit(Instr::Add(a, v)),
+            });
+        }
+        if constant != 0.0 {
+            acc = Some(match acc {
+                None => Operand::Const(constant),
+                Some(a) if constant > 0.0 => self.emit(Instr::Add(a, Operand::Const(constant))),
+                Some(a) => self.emit(Instr::Sub(a, Operand::Const(-constant))),
+            });
+        }
+        let negs: Vec<(ExprId, f64)> = terms.iter().copied().filter(|t| t.1 < 0.0).collect();
+        let mut skip = usize::MAX;
+        if acc.is_none() {
+            // All terms negative, no constant.
+            if let Some(i) = negs.iter().position(|t| t.1 != -1.0) {
+                acc = Some(scaled(self, op(negs[i].0), negs[i].1));
+                skip = i;
+            } else if negs.len() == 1 {
+                return self.emit(Instr::Neg(op(negs[0].0)));
+            } else {
+                let mut a = op(negs[0].0);
+                for &(b, _) in &negs[1..] {
+                    a = self.emit(Instr::Add(a, op(b)));
+                }
+                return self.emit(Instr::Neg(a));
+            }
+        }
+        let mut a = acc.unwrap_or(Operand::Const(0.0));
+        for (i, &(b, c)) in negs.iter().enumerate() {
+            if i != skip {
+                let v = scaled(self, op(b), -c);
+                a = self.emit(Instr::Sub(a, v));
+            }
+        }
+        a
+    }
+}
+
+/// Straight-line code computing a list of outputs: instruction `k` defines temporary `t_k` from
+/// inputs, constants and earlier temporaries (so the list is in topological order), each shared
+/// subexpression computed once.
+///
+/// Lowering: n-ary sums and products become chains of binary operations; negative coefficients
+/// become subtractions; integer powers use binary powering with `x²` etc. shared between all
+/// uses; negative powers are collected into one division per product (`x⁻¹` becomes `1/x`).
+/// Equal instructions are emitted once (value numbering on top of the DAG's hash-consing).
+/// `sin` and `cos` of the same argument are separate instructions with the same operand;
+/// a code generator may pair them into `sin_cos` (see [`Program::sin_cos_pairs`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Program {
+    /// The instructions; `t_k` is the result of `instrs[k]`.
+    pub instrs: Vec<Instr>,
+    /// The value of each output (a temporary, an input or a constant).
+    pub outputs: Vec<Operand>,
+}
+
+impl Program {
+    /// Common-subexpression elimination of `outputs` (all together) into a program.
+    pub fn compile(ctx: &Context, outputs: &[ExprId]) -> Program {
+        let order = ctx.reachable(outputs);
+        let mut b = Builder::new(true);
+        let mut ops: HashMap<ExprId, Operand> = HashMap::with_capacity(order.len());
+        for id in order {
+            let o = b.lower(ctx.node(id), |c| ops[&c]);
+            ops.insert(id, o);
+        }
+        Program {
+            instrs: b.instrs,
+            outputs: outputs.iter().map(|o| ops[o]).collect(),
+        }
+    }
+
+    /// Operation counts of the program.
+    pub fn op_counts(&self) -> OpCounts {
+        self.instrs
+            .iter()
+            .fold(OpCounts::default(), |acc, i| acc.plus(i.counts()))
+    }
+
+    /// Inputs read by the program, sorted and deduplicated.
+    pub fn symbols(&self) -> Vec<Symbol> {
+        let mut out = Vec::new();
+        for i in &self.instrs {
+            i.for_each_operand(|o| {
+                if let Operand::Sym(s) = o {
+                    out.push(s)
+                }
+            });
+        }
+        for o in &self.outputs {
+            if let Operand::Sym(s) = o {
+                out.push(*s);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Pairs `(k_sin, k_cos)` of instructions computing sin and cos of the same operand.
+    pub fn sin_cos_pairs(&self) -> Vec<(u32, u32)> {
+        let mut sins: HashMap<OpKey, u32> = HashMap::new();
+        for (k, i) in self.instrs.iter().enumerate() {
+            if let Instr::Call(Func::Sin, a) = i {
+                sins.insert(key(*a), k as u32);
+            }
+        }
+        let mut out = Vec::new();
+        for (k, i) in self.instrs.iter().enumerate() {
+            if let Instr::Call(Func::Cos, a) = i
+                && let Some(&s) = sins.get(&key(*a))
+            {
+                out.push((s, k as u32));
+            }
+        }
+        out
+    }
+
+    /// For each temporary, the index of the last instruction reading it, or `instrs.len()` if
+    /// it is an output (live to the end).
+    pub fn last_uses(&self) -> Vec<usize> {
+        let n = self.instrs.len();
+        let mut last: Vec<usize> = (0..n).collect();
+        for (k, i) in self.instrs.iter().enumerate() {
+            i.for_each_operand(|o| {
+                if let Operand::Tmp(t) = o {
+                    last[t as usize] = k;
+                }
+            });
+        }
+        for o in &self.outputs {
+            if let Operand::Tmp(t) = o {
+                last[*t as usize] = n;
+            }
+        }
+        last
+    }
+
+    /// Evaluates the program (reference interpreter). A non-finite intermediate value is an
+    /// error naming the instruction.
+    pub fn eval(&self, values: &Values) -> Result<Vec<f64>, CasError> {
+        let mut tmp = Vec::with_capacity(self.instrs.len());
+        for (k, i) in self.instrs.iter().enumerate() {
+            let x = i.apply(|o| operand_value(o, &tmp, values))?;
+            if !x.is_finite() {
+                return Err(CasError::NonFinite {
+                    value: x,
+                    location: format!("instruction t{k}"),
+                });
+            }
+            tmp.push(x);
+        }
+        self.outputs
+            .iter()
+            .map(|&o| operand_value(o, &tmp, values))
+            .collect()
+    }
+
+    /// Splits the program into chunks of at most `max_instrs` consecutive instructions, for
+    /// code generators that emit one function per chunk. Temporaries used outside the chunk
+    /// that defines them (and all temporary outputs) travel through a scratch array: their
+    /// defining chunk stores them into a slot, later chunks load them from it. Slots are reused
+    /// once a temporary is dead (greedy allocation in chunk order).
+    pub fn split(&self, max_instrs: usize) -> Result<SplitProgram, CasError> {
+        if max_instrs == 0 {
+            return Err(CasError::InvalidArgument(
+                "split: max_instrs must be at least 1".to_string(),
+            ));
+        }
+        let n = self.instrs.len();
+        let n_chunks = n.div_ceil(max_instrs);
+        let chunk_of = |k: usize| k / max_instrs;
+        // Last chunk using each temporary (n_chunks = an output).
+        let mut last_chunk: Vec<usize> = (0..n).map(chunk_of).collect();
+        for (k, i) in self.instrs.iter().enumerate() {
+            i.for_each_operand(|o| {
+                if let Operand::Tmp(t) = o {
+                    last_chunk[t as usize] = last_chunk[t as usize].max(chunk_of(k));
+                }
+            });
+        }
+        for o in &self.outputs {
+            if let Operand::Tmp(t) = o {
+                last_chunk[*t as usize] = n_chunks;
+            }
+        }
+        let mut slot_of_tmp: Vec<Option<u32>> = vec![None; n];
+        let mut free: Vec<u32> = Vec::new();
+        let mut active: Vec<(usize, u32)> = Vec::new(); // (last chunk, slot)
+        let mut n_slots = 0u32;
+        let mut chunks = Vec::with_capacity(n_chunks);
+        for c in 0..n_chunks {
+            let range = c * max_instrs..((c + 1) * max_instrs).min(n);
+            active.retain(|&(l, s)| {
+                if l < c {
+                    free.push(s);
+                    false
+                } else {
+                    true
+                }
+            });
+            let mut loads = Vec::new();
+            let mut stores = Vec::new();
+            for k in range.clone() {
+                self.instrs[k].for_each_operand(|o| {
+                    if let Operand::Tmp(t) = o
+                        && (t as usize) < range.start
+                    {
+                        let s = slot_of_tmp[t as usize];
+                        if let Some(s) = s
+                            && !loads.contains(&(t, s))
+                        {
+                            loads.push((t, s));
+                        }
+                    }
+                });
+                if last_chunk[k] > c {
+                    let s = free.pop().unwrap_or_else(|| {
+                        n_slots += 1;
+                        n_slots - 1
+                    });
+                    slot_of_tmp[k] = Some(s);
+                    active.push((last_chunk[k], s));
+                    stores.push((k as u32, s));
+                }
+            }
+            chunks.push(Chunk {
+                instrs: range,
+                loads,
+                stores,
+            });
+        }
+        Ok(SplitProgram {
+            chunks,
+            n_slots: n_slots as usize,
+            slot_of_tmp,
+        })
+    }
+}
+
+fn operand_value(o: Operand, tmp: &[f64], values: &Values) -> Result<f64, CasError> {
+    match o {
+        Operand::Tmp(k) => tmp.get(k as usize).copied().ok_or_else(|| {
+            CasError::InvalidArgument(format!("temporary t{k} read before it is defined"))
+        }),
+        Operand::Sym(s) => values.get(s),
+        Operand::Const(c) => Ok(c),
+    }
+}
+
+impl fmt::Display for Program {
+    /// One line per instruction (`t3 = t1 * q[0]`), then `out[i] = ...`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (k, i) in self.instrs.iter().enumerate() {
+            write!(f, "t{k} = ")?;
+            match i {
+                Instr::Add(a, b) => writeln!(f, "{a} + {b}")?,
+                Instr::Sub(a, b) => writeln!(f, "{a} - {b}")?,
+                Instr::Mul(a, b) => writeln!(f, "{a} * {b}")?,
+                Instr::Div(a, b) => writeln!(f, "{a} / {b}")?,
+                Instr::Neg(a) => writeln!(f, "-{a}")?,
+                Instr::Call(func, a) => writeln!(f, "{}({a})", func.name())?,
+                Instr::Atan2(y, x) => writeln!(f, "atan2({y}, {x})")?,
+            }
+        }
+        for (i, o) in self.outputs.iter().enumerate() {
+            writeln!(f, "out[{i}] = {o}")?;
+        }
+        Ok(())
+    }
+}
+
+/// One chunk of a [`SplitProgram`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chunk {
+    /// The instructions of the chunk (indices into [`Program::instrs`]).
+    pub instrs: Range<usize>,
+    /// `(temporary, slot)`: temporaries of earlier chunks read here, to load from the scratch
+    /// array before the chunk runs.
+    pub loads: Vec<(u32, u32)>,
+    /// `(temporary, slot)`: temporaries defined here and needed later (by later chunks or as
+    /// outputs), to store into the scratch array.
+    pub stores: Vec<(u32, u32)>,
+}
+
+/// A [`Program`] split into chunks (see [`Program::split`]). Outputs that are temporaries are
+/// read from the scratch array at `slot_of_tmp[t]` after the last chunk.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplitProgram {
+    /// Chunks in execution order.
+    pub chunks: Vec<Chunk>,
+    /// Length of the scratch array.
+    pub n_slots: usize,
+    /// Scratch slot of each temporary that crosses a chunk boundary (`None`: local to its chunk).
+    pub slot_of_tmp: Vec<Option<u32>>,
+}
+
+impl SplitProgram {
+    /// Evaluates `prog` chunk by chunk, each chunk seeing only its own temporaries and its
+    /// loads (as generated code would), to check the split.
+    pub fn eval(&self, prog: &Program, values: &Values) -> Result<Vec<f64>, CasError> {
+        let mut scratch = vec![f64::NAN; self.n_slots];
+        let mut local: Vec<Option<f64>> = vec![None; prog.instrs.len()];
+        for chunk in &self.chunks {
+            local.iter_mut().for_each(|x| *x = None);
+            for &(t, s) in &chunk.loads {
+                local[t as usize] = Some(scratch[s as usize]);
+            }
+            for k in chunk.instrs.clone() {
+                let get = |o: Operand| match o {
+                    Operand::Tmp(t) => local[t as usize].ok_or_else(|| {
+                        CasError::InvalidArgument(format!(
+                            "chunk at t{} reads t{t}, which it neither defines nor loads",
+                            chunk.instrs.start
+                        ))
+                    }),
+                    Operand::Sym(s) => values.get(s),
+                    Operand::Const(c) => Ok(c),
+                };
+                let x = prog.instrs[k].apply(get)?;
+                if !x.is_finite() {
+                    return Err(CasError::NonFinite {
+                        value: x,
+                        location: format!("instruction t{k}"),
+                    });
+                }
+                local[k] = Some(x);
+            }
+            for &(t, s) in &chunk.stores {
+                scratch[s as usize] = local[t as usize].unwrap_or(f64::NAN);
+            }
+        }
+        prog.outputs
+            .iter()
+            .map(|&o| match o {
+                Operand::Tmp(t) => match self.slot_of_tmp.get(t as usize).copied().flatten() {
+                    Some(s) => Ok(scratch[s as usize]),
+                    None => Err(CasError::InvalidArgument(format!(
+                        "output temporary t{t} has no scratch slot"
+                    ))),
+                },
+                Operand::Sym(s) => values.get(s),
+                Operand::Const(c) => Ok(c),
+            })
+            .collect()
+    }
+}
+
+impl Context {
+    /// Operation counts of `roots` as fully expanded trees (no sharing at all: every use of a
+    /// subexpression is counted again), lowered like [`Program::compile`] does.
+    pub fn tree_op_counts(&self, roots: &[ExprId]) -> OpCounts {
+        let order = self.reachable(roots);
+        let mut tree: HashMap<ExprId, OpCounts> = HashMap::with_capacity(order.len());
+        let mut b = Builder::new(false);
+        for id in order {
+            let node = self.node(id);
+            b.instrs.clear();
+            b.lower(node, |_| Operand::Tmp(0));
+            let mut c = b
+                .instrs
+                .iter()
+                .fold(OpCounts::default(), |acc, i| acc.plus(i.counts()));
+            node.for_each_child(|ch| c = c.plus(tree[&ch]));
+            tree.insert(id, c);
+        }
+        roots
+            .iter()
+            .fold(OpCounts::default(), |acc, r| acc.plus(tree[r]))
+    }
+}
