@@ -1,1 +1,357 @@
-//! (being written)
+//! Hertzian contact of two elastic bodies: semi-axes of the contact ellipse,
+//! approach (mutual approach of distant points), peak pressure, and the inverse
+//! problem (normal force from approach).
+//!
+//! Theory (Hertz 1882; Johnson, *Contact Mechanics*, 1985, Sect. 4.2): near the
+//! contact point the gap is `h = A x² + B y²` with the *relative curvatures*
+//! `A = (κ₁ₓ + κ₂ₓ)/2`, `B = (κ₁ᵧ + κ₂ᵧ)/2` (κ in 1/m, convex positive). The
+//! contact area is an ellipse with semi-axes `a` (along x, the rolling direction)
+//! and `b` (along y). With the major semi-axis along the direction of the smaller
+//! relative curvature, eccentricity `e² = 1 − (minor/major)²` and complete
+//! elliptic integrals `K(e)`, `E(e)`, Johnson's Eq. (4.39):
+//!
+//! ```text
+//! B'/A' = ((major/minor)² E − K) / (K − E)          (A' ≤ B', A' along the major axis)
+//! major³ = 3 N (K − E) / (2π A' E* e²)
+//! p_max = 3 N / (2π a b),   δ = p_max · minor · K / E*
+//! 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂
+//! ```
+//!
+//! The eccentricity is solved from `B'/A'` by a safeguarded secant iteration on
+//! `ln(minor/major)`; `K` and `E` come from the arithmetic–geometric mean, with a
+//! series for `(K − E)/e²` at small eccentricity so that the circle (`A = B`) is
+//! exact and not a 0/0.
+//!
+//! Classic "Hertz coefficients" `m`, `n` (tabulated against `θ`, `cos θ = |B − A|/(A + B)`)
+//! follow as `major = m·∛(3N/(4E*(A + B)))`, `minor = n·∛(…)`; see [`HertzShape::m_n`].
+
+use std::f64::consts::PI;
+
+/// Errors of the Hertz solution.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HertzError {
+    /// A relative curvature is not positive (non-convex contact or bad input).
+    #[error(
+        "Hertz: relative curvatures must be positive and finite, got A = {a} 1/m (rolling direction), B = {b} 1/m (transverse)"
+    )]
+    Curvature {
+        /// Relative curvature in the rolling direction, 1/m.
+        a: f64,
+        /// Relative curvature in the transverse direction, 1/m.
+        b: f64,
+    },
+    /// Bad elastic constants.
+    #[error("Hertz: {0}")]
+    Material(String),
+    /// Bad normal force or approach.
+    #[error("Hertz: {0}")]
+    Load(String),
+}
+
+/// Complete elliptic integrals of the first and second kind, `K(m)` and `E(m)`,
+/// with parameter `m = k² = e²` in `[0, 1)`, by the arithmetic–geometric mean
+/// (Abramowitz & Stegun 17.6). Relative accuracy ~1e-15.
+pub fn elliptic_ke(m: f64) -> (f64, f64) {
+    let mut a = 1.0;
+    let mut b = (1.0 - m).sqrt();
+    let mut c2sum = 0.5 * m; // Σ 2^(n-1) c_n², c_0² = m
+    let mut pow2 = 0.5;
+    for _ in 0..40 {
+        let an = 0.5 * (a + b);
+        let bn = (a * b).sqrt();
+        let cn = 0.5 * (a - b);
+        pow2 *= 2.0;
+        c2sum += pow2 * cn * cn;
+        a = an;
+        b = bn;
+        if cn.abs() <= 1e-17 * a {
+            break;
+        }
+    }
+    let k = PI / (2.0 * a);
+    (k, k * (1.0 - c2sum))
+}
+
+/// `(K(m) − E(m))/m`, accurate also as `m → 0` (series `π/4 (1 + 3m/8 + 15m²/64 + 175m³/1024)`).
+fn k_minus_e_over_m(m: f64, k: f64, e: f64) -> f64 {
+    if m < 1e-3 {
+        PI / 4.0 * (1.0 + m * (3.0 / 8.0 + m * (15.0 / 64.0 + m * 175.0 / 1024.0)))
+    } else {
+        (k - e) / m
+    }
+}
+
+/// Ratio `B'/A'` (larger over smaller relative curvature) produced by an ellipse
+/// with axis ratio `kp = minor/major`.
+fn curvature_ratio(kp: f64) -> f64 {
+    let m = 1.0 - kp * kp;
+    let (k, e) = elliptic_ke(m);
+    let kme = k_minus_e_over_m(m, k, e) * m;
+    if m < 1e-3 {
+        // (E/kp² − K)/(K − E) with both numerator and denominator O(m): series
+        // numerator/m = π/4 (1 + 9m/8 + …) (from the K, E series), so the ratio is
+        // (1 + 9m/8 + 75m²/64)/(1 + 3m/8 + 15m²/64).
+        let num = 1.0 + m * (9.0 / 8.0 + m * (75.0 / 64.0));
+        let den = 1.0 + m * (3.0 / 8.0 + m * (15.0 / 64.0));
+        return num / den;
+    }
+    (e / (kp * kp) - k) / kme
+}
+
+/// Shape of a Hertzian contact for given curvatures and materials: everything
+/// that does not depend on the normal force. Solve once per geometry, then
+/// evaluate [`HertzShape::contact`] / [`HertzShape::normal_force`] cheaply
+/// (the size scales as `N^(1/3)`, the approach as `N^(2/3)`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HertzShape {
+    /// Relative curvature in the rolling direction `A`, 1/m.
+    pub curv_a: f64,
+    /// Relative curvature in the transverse direction `B`, 1/m.
+    pub curv_b: f64,
+    /// Effective modulus `E*`, Pa (`1/E* = Σ (1 − νᵢ²)/Eᵢ`).
+    pub e_star: f64,
+    /// Axis ratio `b/a` (transverse over rolling), –.
+    pub b_over_a: f64,
+    /// `a = a_coef · N^(1/3)` (a in m, N in newtons).
+    a_coef: f64,
+    /// `δ = d_coef · N^(2/3)`.
+    d_coef: f64,
+}
+
+/// A solved Hertzian contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HertzContact {
+    /// Semi-axis in the rolling direction, m.
+    pub a: f64,
+    /// Semi-axis in the transverse direction, m.
+    pub b: f64,
+    /// Approach (elastic compression of both bodies together), m.
+    pub approach: f64,
+    /// Peak pressure `3N/(2πab)`, Pa.
+    pub p_max: f64,
+    /// Normal force, N.
+    pub normal_force: f64,
+}
+
+/// Relative curvatures `(A, B)` (1/m) of a wheel on a rail: wheel rolling radius
+/// `r_wheel` (m; rolling-direction curvature `1/r`), wheel transverse profile
+/// curvature and rail transverse profile curvature (1/m, convex positive — a
+/// concave wheel throat is negative), rail rolling-direction curvature 0.
+pub fn wheel_rail_curvatures(
+    r_wheel: f64,
+    wheel_transverse_curvature: f64,
+    rail_transverse_curvature: f64,
+) -> (f64, f64) {
+    (
+        0.5 / r_wheel,
+        0.5 * (wheel_transverse_curvature + rail_transverse_curvature),
+    )
+}
+
+/// Effective modulus `E*` (Pa) of two bodies of the same material: `E/(2(1 − ν²))`.
+pub fn effective_modulus(e: f64, nu: f64) -> f64 {
+    e / (2.0 * (1.0 - nu * nu))
+}
+
+impl HertzShape {
+    /// Solves the shape for relative curvatures `curv_a` (rolling direction),
+    /// `curv_b` (transverse), both 1/m and positive, and wheel and rail of one
+    /// material with Young's modulus `e` (Pa) and Poisson ratio `nu`.
+    pub fn new(curv_a: f64, curv_b: f64, e: f64, nu: f64) -> Result<Self, HertzError> {
+        if !(e.is_finite() && e > 0.0) {
+            return Err(HertzError::Material(format!(
+                "Young's modulus must be positive and finite, got {e} Pa"
+            )));
+        }
+        if !(nu.is_finite() && (0.0..0.5).contains(&nu)) {
+            return Err(HertzError::Material(format!(
+                "Poisson ratio must be in [0, 0.5), got {nu}"
+            )));
+        }
+        Self::with_modulus(curv_a, curv_b, effective_modulus(e, nu))
+    }
+
+    /// As [`HertzShape::new`] with the effective modulus `E*` (Pa) given.
+    pub fn with_modulus(curv_a: f64, curv_b: f64, e_star: f64) -> Result<Self, HertzError> {
+        if !(curv_a.is_finite() && curv_b.is_finite() && curv_a > 0.0 && curv_b > 0.0) {
+            return Err(HertzError::Curvature {
+                a: curv_a,
+                b: curv_b,
+            });
+        }
+        if !(e_star.is_finite() && e_star > 0.0) {
+            return Err(HertzError::Material(format!(
+                "effective modulus must be positive and finite, got {e_star} Pa"
+            )));
+        }
+        let (small, large) = if curv_a <= curv_b {
+            (curv_a, curv_b)
+        } else {
+            (curv_b, curv_a)
+        };
+        let ratio = large / small;
+        let kp = solve_axis_ratio(ratio);
+        let m = 1.0 - kp * kp;
+        let (k, e) = elliptic_ke(m);
+        let kme_m = k_minus_e_over_m(m, k, e);
+        // major³ = 3N (K − E)/(2π A' E* e²) for N = 1.
+        let major = (3.0 * kme_m / (2.0 * PI * small * e_star)).cbrt();
+        let minor = major * kp;
+        let p0 = 3.0 / (2.0 * PI * major * minor);
+        let d_coef = p0 * minor * k / e_star;
+        let (a_coef, b_over_a) = if curv_a <= curv_b {
+            (major, kp)
+        } else {
+            (minor, 1.0 / kp)
+        };
+        Ok(Self {
+            curv_a,
+            curv_b,
+            e_star,
+            b_over_a,
+            a_coef,
+            d_coef,
+        })
+    }
+
+    /// The contact under normal force `n` (N, ≥ 0). Zero force gives a zero-size
+    /// contact.
+    pub fn contact(&self, n: f64) -> Result<HertzContact, HertzError> {
+        if !(n.is_finite() && n >= 0.0) {
+            return Err(HertzError::Load(format!(
+                "normal force must be finite and non-negative, got {n} N"
+            )));
+        }
+        let c = n.cbrt();
+        let a = self.a_coef * c;
+        let b = a * self.b_over_a;
+        let p_max = if n > 0.0 {
+            3.0 * n / (2.0 * PI * a * b)
+        } else {
+            0.0
+        };
+        Ok(HertzContact {
+            a,
+            b,
+            approach: self.d_coef * c * c,
+            p_max,
+            normal_force: n,
+        })
+    }
+
+    /// Normal force (N) for a given approach `delta` (m): `N = (δ/δ₁)^(3/2)`
+    /// where `δ₁` is the approach under 1 N; zero for `δ ≤ 0` (no contact).
+    pub fn normal_force(&self, delta: f64) -> Result<f64, HertzError> {
+        if !delta.is_finite() {
+            return Err(HertzError::Load(format!(
+                "approach must be finite, got {delta} m"
+            )));
+        }
+        if delta <= 0.0 {
+            return Ok(0.0);
+        }
+        Ok((delta / self.d_coef).powf(1.5))
+    }
+
+    /// Contact stiffness `dN/dδ` (N/m) at approach `delta` (m): `1.5 N/δ`.
+    pub fn stiffness(&self, delta: f64) -> f64 {
+        if delta <= 0.0 || !delta.is_finite() {
+            return 0.0;
+        }
+        1.5 * (delta / self.d_coef).sqrt() / self.d_coef
+    }
+
+    /// The classic Hertz coefficients `(m, n)` of the major and minor semi-axis:
+    /// `major = m·∛(3N/(4E*(A + B)))`, `minor = n·∛(…)` — independent of load and
+    /// modulus, a function of `θ` with `cos θ = |B − A|/(A + B)` only.
+    pub fn m_n(&self) -> (f64, f64) {
+        let scale = (3.0 / (4.0 * self.e_star * (self.curv_a + self.curv_b))).cbrt();
+        let a = self.a_coef;
+        let b = a * self.b_over_a;
+        (a.max(b) / scale, a.min(b) / scale)
+    }
+}
+
+/// Solves `curvature_ratio(kp) = ratio` for the axis ratio `kp = minor/major` in
+/// `(0, 1]`, `ratio ≥ 1`: secant/bisection on `u = ln kp`.
+fn solve_axis_ratio(ratio: f64) -> f64 {
+    if ratio <= 1.0 + 1e-14 {
+        return 1.0;
+    }
+    // Bracket: f(u) = ln(curvature_ratio(e^u)) − ln(ratio), decreasing in u;
+    // f(0) = −ln(ratio) < 0. Lower bound: kp ≥ 1e-12 covers ratio up to ~1e23.
+    let target = ratio.ln();
+    let f = |u: f64| curvature_ratio(u.exp()).ln() - target;
+    let mut hi = 0.0_f64; // f(hi) < 0
+    let mut f_hi = -target;
+    // Initial guess kp ≈ ratio^(-2/3) (Greenwood's approximation).
+    let mut lo = (-2.0 / 3.0 * target).min(-1e-6);
+    let mut f_lo = f(lo);
+    while f_lo < 0.0 {
+        hi = lo;
+        f_hi = f_lo;
+        lo *= 2.0;
+        if lo < -28.0 {
+            lo = -28.0;
+            f_lo = f(lo);
+            break;
+        }
+        f_lo = f(lo);
+    }
+    if f_lo < 0.0 {
+        return lo.exp();
+    }
+    // Illinois false position between lo (f ≥ 0) and hi (f < 0).
+    let mut side = 0;
+    let mut u = lo;
+    for _ in 0..100 {
+        u = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+        let fu = f(u);
+        if fu.abs() < 1e-14 || (hi - lo).abs() < 1e-15 {
+            break;
+        }
+        if fu > 0.0 {
+            lo = u;
+            f_lo = fu;
+            if side == 1 {
+                f_hi *= 0.5;
+            }
+            side = 1;
+        } else {
+            hi = u;
+            f_hi = fu;
+            if side == -1 {
+                f_lo *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    u.exp()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn elliptic_integrals_known_values() {
+        // A&S Table 17.1: K(0.5) = 1.854074677301372, E(0.5) = 1.350643881047675.
+        let (k, e) = elliptic_ke(0.5);
+        assert!((k - 1.854_074_677_301_372).abs() < 1e-13);
+        assert!((e - 1.350_643_881_047_675).abs() < 1e-13);
+        let (k0, e0) = elliptic_ke(0.0);
+        assert!((k0 - PI / 2.0).abs() < 1e-15 && (e0 - PI / 2.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn circle_matches_sphere_formula() {
+        // Sphere of radius R on a plane: a³ = 3NR/(4E*) (Johnson Eq. 4.22).
+        let r = 0.5;
+        let s = HertzShape::with_modulus(0.5 / r, 0.5 / r, 1e11).unwrap();
+        let c = s.contact(1000.0).unwrap();
+        let a = (3.0 * 1000.0 * r / (4.0 * 1e11)).cbrt();
+        assert!((c.a / a - 1.0).abs() < 1e-12 && (c.b / a - 1.0).abs() < 1e-12);
+        // δ = a²/R.
+        assert!((c.approach / (a * a / r) - 1.0).abs() < 1e-12);
+    }
+}
