@@ -7,12 +7,18 @@
 //! [`Scenario`]) that both engines — the numeric-iterative `runtime` and the
 //! symbolic `codegen` — consume.
 
+mod error;
 pub mod expr;
+mod load;
+mod locate;
 pub mod model;
 pub mod parser;
+mod raw;
 pub mod scenario;
 
+pub use error::{ModelError, ModelErrors};
 pub use expr::{Expr, Func};
+pub use load::{load_model, parse_model};
 pub use model::*;
 pub use parser::{ParseError, ParseErrorKind, parse_expr, parse_expr_with};
 pub use scenario::*;

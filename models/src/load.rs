@@ -1,0 +1,1139 @@
+//! Loading a model file: RON → raw syntax → resolved, validated [`Model`].
+
+use crate::error::{ModelError, ModelErrors};
+use crate::expr::Expr;
+use crate::locate::{Locator, Span};
+use crate::model::*;
+use crate::parser::{ParseErrorKind, is_identifier, is_reserved_name, parse_expr};
+use crate::raw::*;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Reads and resolves a model file. All problems found are returned together.
+pub fn load_model(path: &Path) -> Result<Model, ModelErrors> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", format!("cannot read the model file: {e}")))?;
+    parse_model(&text, path)
+}
+
+/// Resolves model text; `file` names the source in errors and in [`Model::source`].
+pub fn parse_model(text: &str, file: &Path) -> Result<Model, ModelErrors> {
+    let loc = Locator::new(text);
+    let raw: RawModel = ron::Options::default()
+        .from_str(text)
+        .map_err(|e| ron_error(&loc, file, e))?;
+    let mut cx = Cx {
+        file,
+        loc,
+        errors: Vec::new(),
+        names: Vec::new(),
+        defaults: None,
+    };
+    let model = cx.resolve(raw);
+    if cx.errors.is_empty() {
+        Ok(model)
+    } else {
+        let mut errors = cx.errors;
+        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        Err(ModelErrors(errors))
+    }
+}
+
+/// A RON syntax or structure error, with its position and the element around it.
+pub(crate) fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError) -> ModelErrors {
+    let pos = (e.span.start.line, e.span.start.col);
+    let element = loc
+        .enclosing_named(loc.offset_of(pos.0, pos.1))
+        .map(|(ctor, name)| format!("{} \"{name}\"", kind_of(&ctor)))
+        .unwrap_or_default();
+    ModelErrors(vec![ModelError {
+        file: file.to_path_buf(),
+        element,
+        message: e.code.to_string(),
+        position: Some(pos),
+    }])
+}
+
+const BODY: &[&str] = &["Body"];
+const CUT: &[&str] = &["CutJoint"];
+const FORCE: &[&str] = &["Spring", "Linear6", "Applied"];
+
+fn kind_of(ctor: &str) -> &'static str {
+    match ctor {
+        "Body" => "body",
+        "CutJoint" => "cut joint",
+        "Spring" | "Linear6" | "Applied" => "force",
+        "Scenario" => "scenario",
+        "Model" => "model",
+        _ => "element",
+    }
+}
+
+/// Where an error is: used to name the element and to find its position.
+#[derive(Debug, Clone)]
+enum Where {
+    Top,
+    /// Constructors, name, occurrence (0 = first element with that name).
+    Elem(&'static [&'static str], String, usize),
+    Param(String),
+    Macro(String),
+}
+
+impl Where {
+    fn label(&self) -> String {
+        match self {
+            Where::Top => String::new(),
+            Where::Elem(c, n, _) => format!("{} \"{n}\"", kind_of(c[0])),
+            Where::Param(n) => format!("parameter \"{n}\""),
+            Where::Macro(n) => format!("macro \"{n}\""),
+        }
+    }
+}
+
+struct Cx<'a> {
+    file: &'a Path,
+    loc: Locator<'a>,
+    errors: Vec<ModelError>,
+    /// Parameter names, index = `Expr::Param` index.
+    names: Vec<String>,
+    /// Default parameter values, when they could all be evaluated.
+    defaults: Option<Vec<f64>>,
+}
+
+fn axis_name(a: Axis) -> &'static str {
+    match a {
+        Axis::X => "x",
+        Axis::Y => "y",
+        Axis::Z => "z",
+    }
+}
+
+impl Cx<'_> {
+    fn span_of(&self, w: &Where) -> Option<Span> {
+        match w {
+            Where::Top => self.loc.top(),
+            Where::Elem(ctors, name, nth) => {
+                let mut found = self.loc.element(ctors, name, *nth);
+                if found.is_none() {
+                    found = self.loc.element(ctors, name, 0);
+                }
+                found
+            }
+            Where::Param(n) => {
+                let map = self.loc.field_group(self.loc.top()?, "parameters")?;
+                let k = self.loc.map_entry(map, n)?;
+                Some((k, k + 3))
+            }
+            Where::Macro(n) => {
+                let map = self.loc.field_group(self.loc.top()?, "macros")?;
+                let k = self.loc.map_entry(map, n)?;
+                let (_, close) = self.loc.map_entry_group(map, n)?;
+                Some((k, close))
+            }
+        }
+    }
+
+    /// Records an error at the string literal `literal` or the key `key` inside the element.
+    fn err(&mut self, w: &Where, key: Option<&str>, literal: Option<&str>, message: String) {
+        let position = self.span_of(w).map(|span| {
+            let tok = literal
+                .and_then(|l| self.loc.string_in(span, l))
+                .or_else(|| key.and_then(|k| self.loc.key_anywhere(span, k)))
+                .unwrap_or_else(|| self.loc.start_of(span));
+            self.loc.pos(tok)
+        });
+        self.errors.push(ModelError {
+            file: self.file.to_path_buf(),
+            element: w.label(),
+            message,
+            position,
+        });
+    }
+
+    /// Resolves a numeric field. `label` names it in messages, `key` is its RON key.
+    fn expr(&mut self, w: &Where, label: &str, key: &str, v: &Value, allow_time: bool) -> Expr {
+        match v {
+            Value::Num(x) => {
+                if !x.is_finite() {
+                    self.err(w, Some(key), None, format!("{label} is not finite: {x}"));
+                }
+                Expr::Num(*x)
+            }
+            Value::Text(s) => match parse_expr(s, &self.names, allow_time) {
+                Ok(e) => {
+                    if !e.has_time()
+                        && let Some(d) = &self.defaults
+                    {
+                        let x = e.eval(d, 0.0);
+                        if !x.is_finite() {
+                            self.err(
+                                w,
+                                Some(key),
+                                Some(s),
+                                format!(
+                                    "{label} = \"{s}\" is not finite with the default parameters: {x}"
+                                ),
+                            );
+                        }
+                    }
+                    e
+                }
+                Err(pe) => {
+                    let msg = match &pe.kind {
+                        ParseErrorKind::UnknownIdentifier(n) => {
+                            format!("unknown identifier \"{n}\" in {label} (\"{s}\")")
+                        }
+                        ParseErrorKind::TimeNotAllowed => format!(
+                            "time t is not allowed in {label} (\"{s}\"); only elementary transforms and applied forces may depend on time"
+                        ),
+                        ParseErrorKind::Syntax { .. } => format!("{label}: {pe}"),
+                    };
+                    self.err(w, Some(key), Some(s), msg);
+                    Expr::Num(f64::NAN)
+                }
+            },
+        }
+    }
+
+    fn vec3(&mut self, w: &Where, label: &str, v: &Vec3, allow_time: bool) -> [Expr; 3] {
+        let comps = [&v.0, &v.1, &v.2];
+        std::array::from_fn(|i| {
+            let l = format!("{label}.{}", ["x", "y", "z"][i]);
+            self.expr(w, &l, label, comps[i], allow_time)
+        })
+    }
+
+    fn vec6(&mut self, w: &Where, label: &str, v: &Vec6) -> [Expr; 6] {
+        let comps = [&v.0, &v.1, &v.2, &v.3, &v.4, &v.5];
+        std::array::from_fn(|i| self.expr(w, &format!("{label}[{i}]"), label, comps[i], false))
+    }
+
+    fn resolve(&mut self, raw: RawModel) -> Model {
+        let (parameters, default_exprs) = self.parameters(&raw);
+        let macros = self.macros(&raw);
+        let gravity = self.vec3(&Where::Top, "gravity", &raw.gravity, false);
+        let _ = default_exprs;
+        let (bodies, coordinates, raw_to_new) = self.bodies(&raw);
+        let body_names: HashMap<&str, usize> = raw
+            .bodies
+            .iter()
+            .enumerate()
+            .rev()
+            .map(|(i, b)| (b.name.as_str(), i))
+            .collect();
+        let lookup = Lookup {
+            names: body_names,
+            raw_to_new,
+        };
+        let cut_joints = self.cut_joints(&raw, &lookup);
+        let forces = self.forces(&raw, &lookup);
+        Model {
+            name: raw.name.clone(),
+            source: Some(self.file.to_path_buf()),
+            parameters,
+            macros,
+            gravity,
+            bodies,
+            coordinates,
+            cut_joints,
+            forces,
+        }
+    }
+
+    fn parameters(&mut self, raw: &RawModel) -> (Vec<Parameter>, Vec<Expr>) {
+        let mut kept = Vec::new();
+        for (name, pv) in &raw.parameters.0 {
+            let w = Where::Param(name.clone());
+            if !is_identifier(name) {
+                self.err(
+                    &w,
+                    None,
+                    None,
+                    "not a valid identifier (letters, digits, '_' and '.', starting with a letter or '_')".into(),
+                );
+            } else if is_reserved_name(name) {
+                self.err(
+                    &w,
+                    None,
+                    None,
+                    "the name is reserved (t, pi and function names)".into(),
+                );
+            } else if self.names.contains(name) {
+                self.err(&w, None, None, "duplicate parameter name".into());
+                continue;
+            }
+            self.names.push(name.clone());
+            kept.push(pv);
+        }
+        let exprs: Vec<Expr> = kept
+            .iter()
+            .zip(self.names.clone())
+            .map(|(pv, name)| {
+                let w = Where::Param(name);
+                self.expr(&w, "the default value", "", &pv.value, false)
+            })
+            .collect();
+        let cycles = find_cycles(&exprs);
+        for cycle in &cycles {
+            let mut path: Vec<&str> = cycle.iter().map(|&i| self.names[i].as_str()).collect();
+            path.push(path[0]);
+            let w = Where::Param(self.names[cycle[0]].clone());
+            self.err(
+                &w,
+                None,
+                None,
+                format!("cycle in parameter default values: {}", path.join(" -> ")),
+            );
+        }
+        if self.errors.is_empty()
+            && let Ok(values) = evaluate_parameters(&exprs)
+        {
+            {
+                for (i, v) in values.iter().enumerate() {
+                    if !v.is_finite() {
+                        let w = Where::Param(self.names[i].clone());
+                        self.err(&w, None, None, format!("default value is not finite: {v}"));
+                    }
+                }
+                if values.iter().all(|v| v.is_finite()) {
+                    self.defaults = Some(values);
+                }
+            }
+        }
+        let params = kept
+            .iter()
+            .zip(&self.names)
+            .zip(&exprs)
+            .map(|((pv, name), e)| Parameter {
+                name: name.clone(),
+                default: e.clone(),
+                doc: pv.doc.clone(),
+            })
+            .collect();
+        (params, exprs)
+    }
+
+    fn macros(&mut self, raw: &RawModel) -> Vec<Macro> {
+        let mut out: Vec<Macro> = Vec::new();
+        for (name, assigns) in &raw.macros.0 {
+            let w = Where::Macro(name.clone());
+            if out.iter().any(|m| &m.name == name) {
+                self.err(&w, None, None, "duplicate macro name".into());
+                continue;
+            }
+            let mut assignments = Vec::new();
+            for (pname, v) in &assigns.0 {
+                match self.names.iter().position(|n| n == pname) {
+                    Some(i) => {
+                        let e = self.expr(&w, &format!("the value of \"{pname}\""), "", v, false);
+                        assignments.push((i, e));
+                    }
+                    None => self.err(
+                        &w,
+                        None,
+                        Some(pname),
+                        format!("unknown parameter \"{pname}\""),
+                    ),
+                }
+            }
+            out.push(Macro {
+                name: name.clone(),
+                assignments,
+            });
+        }
+        out
+    }
+
+    /// Bodies in topological order, coordinates, and raw index → new index.
+    fn bodies(&mut self, raw: &RawModel) -> (Vec<Body>, Vec<Coordinate>, Vec<Option<usize>>) {
+        let n = raw.bodies.len();
+        let mut first: HashMap<&str, usize> = HashMap::new();
+        let mut valid = vec![true; n];
+        for (i, b) in raw.bodies.iter().enumerate() {
+            let nth = raw.bodies[..i].iter().filter(|o| o.name == b.name).count();
+            let w = Where::Elem(BODY, b.name.clone(), nth);
+            if b.name.is_empty() {
+                self.err(
+                    &w,
+                    Some("name"),
+                    None,
+                    "a body needs a non-empty name".into(),
+                );
+            }
+            if b.name == "ground" {
+                self.err(
+                    &w,
+                    Some("name"),
+                    None,
+                    "\"ground\" is the inertial frame and cannot name a body".into(),
+                );
+                valid[i] = false;
+            } else if first.contains_key(b.name.as_str()) {
+                self.err(&w, Some("name"), None, "duplicate body name".into());
+                valid[i] = false;
+            } else {
+                first.insert(&b.name, i);
+            }
+        }
+        // Parent of each raw body: None = ground, Some(j) = raw body j.
+        let mut parent: Vec<Option<usize>> = vec![None; n];
+        for (i, b) in raw.bodies.iter().enumerate() {
+            if !valid[i] {
+                continue;
+            }
+            let p = b.joint.parent();
+            if p == "ground" {
+                continue;
+            }
+            match first.get(p) {
+                Some(&j) => parent[i] = Some(j),
+                None => {
+                    let w = Where::Elem(BODY, b.name.clone(), 0);
+                    self.err(
+                        &w,
+                        Some("parent"),
+                        Some(p),
+                        format!("unknown body \"{p}\" as parent"),
+                    );
+                    valid[i] = false;
+                }
+            }
+        }
+        // Topological order, keeping file order where possible; detect loops.
+        // state: 0 unvisited, 1 placed, 2 excluded (in or below a loop, or invalid).
+        let mut state = vec![0u8; n];
+        for i in 0..n {
+            if !valid[i] {
+                state[i] = 2;
+            }
+        }
+        let mut order = Vec::new();
+        for i in 0..n {
+            if state[i] != 0 {
+                continue;
+            }
+            let mut path = Vec::new();
+            let mut cur = Some(i);
+            let mut bad = false;
+            while let Some(c) = cur {
+                if state[c] == 1 {
+                    break;
+                }
+                if state[c] == 2 {
+                    bad = true;
+                    break;
+                }
+                if let Some(k) = path.iter().position(|&p| p == c) {
+                    let cycle: &[usize] = &path[k..];
+                    let mut names: Vec<&str> =
+                        cycle.iter().map(|&j| raw.bodies[j].name.as_str()).collect();
+                    names.push(names[0]);
+                    let w = Where::Elem(BODY, raw.bodies[cycle[0]].name.clone(), 0);
+                    self.err(
+                        &w,
+                        Some("parent"),
+                        None,
+                        format!(
+                            "loop in the body tree (each body's parent follows it): {}",
+                            names.join(" -> ")
+                        ),
+                    );
+                    bad = true;
+                    break;
+                }
+                path.push(c);
+                cur = parent[c];
+            }
+            for &c in path.iter().rev() {
+                if bad {
+                    state[c] = 2;
+                } else {
+                    state[c] = 1;
+                    order.push(c);
+                }
+            }
+        }
+        let mut raw_to_new = vec![None; n];
+        for (k, &i) in order.iter().enumerate() {
+            raw_to_new[i] = Some(k);
+        }
+        let mut bodies = Vec::new();
+        let mut coords: Vec<Coordinate> = Vec::new();
+        for (k, &i) in order.iter().enumerate() {
+            let b = &raw.bodies[i];
+            let w = Where::Elem(BODY, b.name.clone(), 0);
+            let mass = self.expr(&w, "mass", "mass", &b.mass, false);
+            let r = &b.inertia;
+            let inertia = [
+                self.expr(&w, "inertia.ixx", "ixx", &r.ixx, false),
+                self.expr(&w, "inertia.iyy", "iyy", &r.iyy, false),
+                self.expr(&w, "inertia.izz", "izz", &r.izz, false),
+                self.expr(&w, "inertia.ixy", "ixy", &r.ixy, false),
+                self.expr(&w, "inertia.ixz", "ixz", &r.ixz, false),
+                self.expr(&w, "inertia.iyz", "iyz", &r.iyz, false),
+            ];
+            self.check_mass(&w, &mass, &inertia);
+            let parent = match parent[i] {
+                None => BodyRef::Ground,
+                Some(j) => BodyRef::Body(raw_to_new[j].unwrap_or(0)),
+            };
+            let mut jb = JointBuilder {
+                body: k,
+                body_name: &b.name,
+                joint: Vec::new(),
+                coords: Vec::new(),
+            };
+            self.expand_joint(&w, &b.joint, &mut jb);
+            for mut c in jb.coords {
+                if let Some(other) = coords.iter().find(|o| o.name == c.name) {
+                    let other_body = bodies
+                        .get(other.body)
+                        .map_or(b.name.as_str(), |ob: &Body| ob.name.as_str())
+                        .to_string();
+                    self.err(
+                        &w,
+                        None,
+                        Some(&c.name),
+                        format!(
+                            "duplicate coordinate name \"{}\" (also in body \"{other_body}\")",
+                            c.name
+                        ),
+                    );
+                } else if c.name.is_empty() {
+                    self.err(&w, Some("coord"), None, "empty coordinate name".into());
+                } else {
+                    let global = coords.len();
+                    if let Some(el) = jb.joint.get_mut(c.elementary) {
+                        el.motion = Motion::Coordinate(global);
+                    }
+                    c.body = k;
+                    coords.push(c);
+                }
+            }
+            bodies.push(Body {
+                name: b.name.clone(),
+                mass,
+                inertia,
+                parent,
+                joint: jb.joint,
+            });
+        }
+        (bodies, coords, raw_to_new)
+    }
+
+    /// Mass positive; inertia positive definite and physically realizable
+    /// (principal moments satisfy the triangle inequality), with default parameters.
+    fn check_mass(&mut self, w: &Where, mass: &Expr, inertia: &[Expr; 6]) {
+        let Some(d) = self.defaults.clone() else {
+            return;
+        };
+        let m = mass.eval(&d, 0.0);
+        if m.is_finite() && m <= 0.0 {
+            self.err(
+                w,
+                Some("mass"),
+                None,
+                format!("mass must be positive, got {m}"),
+            );
+        }
+        let i: Vec<f64> = inertia.iter().map(|e| e.eval(&d, 0.0)).collect();
+        if i.iter().any(|x| !x.is_finite()) {
+            return;
+        }
+        let (ixx, iyy, izz) = (i[0], i[1], i[2]);
+        // Relative slack for rounding in the defaults' expressions.
+        let slack = 1e-9 * (ixx.abs() + iyy.abs() + izz.abs());
+        for (a, b, c, na, nb, nc) in [
+            (ixx, iyy, izz, "ixx", "iyy", "izz"),
+            (iyy, izz, ixx, "iyy", "izz", "ixx"),
+            (izz, ixx, iyy, "izz", "ixx", "iyy"),
+        ] {
+            if a + b < c - slack {
+                self.err(
+                    w,
+                    Some("inertia"),
+                    None,
+                    format!(
+                        "inertia violates the triangle inequality: {na} + {nb} = {} < {nc} = {c}",
+                        a + b
+                    ),
+                );
+                return;
+            }
+        }
+        let ev = sym3_eigenvalues([[ixx, i[3], i[4]], [i[3], iyy, i[5]], [i[4], i[5], izz]]);
+        if ev.iter().any(|&l| l <= 0.0) {
+            self.err(
+                w,
+                Some("inertia"),
+                None,
+                format!(
+                    "inertia tensor is not positive definite: principal moments {:?} kg m²",
+                    ev
+                ),
+            );
+            return;
+        }
+        let [a, b, c] = ev;
+        if a + b < c - slack || b + c < a - slack || c + a < b - slack {
+            self.err(
+                w,
+                Some("inertia"),
+                None,
+                format!(
+                    "inertia violates the triangle inequality for its principal moments {:?} kg m²",
+                    ev
+                ),
+            );
+        }
+    }
+
+    fn fixed(
+        &mut self,
+        w: &Where,
+        jb: &mut JointBuilder,
+        kind: ElementaryKind,
+        label: &str,
+        key: &str,
+        v: &Value,
+    ) {
+        if v.is_literal_zero() {
+            return;
+        }
+        let e = self.expr(w, label, key, v, false);
+        jb.joint.push(Elementary {
+            kind,
+            motion: Motion::Fixed(e),
+        });
+    }
+
+    fn fixed3(&mut self, w: &Where, jb: &mut JointBuilder, translate: bool, label: &str, v: &Vec3) {
+        let comps = [&v.0, &v.1, &v.2];
+        for (k, axis) in [Axis::X, Axis::Y, Axis::Z].into_iter().enumerate() {
+            let kind = if translate {
+                ElementaryKind::Translation(axis)
+            } else {
+                ElementaryKind::Rotation(axis)
+            };
+            let l = format!("joint.{label}.{}", axis_name(axis));
+            self.fixed(w, jb, kind, &l, label, comps[k]);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn coordinate(
+        &mut self,
+        w: &Where,
+        jb: &mut JointBuilder,
+        kind: ElementaryKind,
+        name: String,
+        init: &Value,
+        vel: &Value,
+        key_init: &str,
+        key_vel: &str,
+    ) {
+        let initial = self.expr(
+            w,
+            &format!("the initial value of \"{name}\""),
+            key_init,
+            init,
+            false,
+        );
+        let initial_velocity = self.expr(
+            w,
+            &format!("the initial velocity of \"{name}\""),
+            key_vel,
+            vel,
+            false,
+        );
+        jb.coords.push(Coordinate {
+            name,
+            body: jb.body,
+            elementary: jb.joint.len(),
+            initial,
+            initial_velocity,
+        });
+        let index = usize::MAX; // patched by the caller's coordinate numbering
+        jb.joint.push(Elementary {
+            kind,
+            motion: Motion::Coordinate(index),
+        });
+    }
+
+    fn expand_joint(&mut self, w: &Where, joint: &RawJoint, jb: &mut JointBuilder) {
+        match joint {
+            RawJoint::Revolute {
+                at,
+                axis,
+                coord,
+                init,
+                vel,
+                to_com,
+                ..
+            }
+            | RawJoint::Prismatic {
+                at,
+                axis,
+                coord,
+                init,
+                vel,
+                to_com,
+                ..
+            } => {
+                let revolute = matches!(joint, RawJoint::Revolute { .. });
+                self.fixed3(w, jb, true, "at", at);
+                let (kind, prefix) = if revolute {
+                    (ElementaryKind::Rotation(*axis), "r")
+                } else {
+                    (ElementaryKind::Translation(*axis), "t")
+                };
+                let name = if coord.is_empty() {
+                    format!("{}.{prefix}{}", jb.body_name, axis_name(*axis))
+                } else {
+                    coord.clone()
+                };
+                self.coordinate(w, jb, kind, name, init, vel, "init", "vel");
+                self.fixed3(w, jb, true, "to_com", to_com);
+            }
+            RawJoint::SixDof {
+                at,
+                order,
+                init,
+                vel,
+                ..
+            } => {
+                self.fixed3(w, jb, true, "at", at);
+                let inits = [&init.0, &init.1, &init.2, &init.3, &init.4, &init.5];
+                let vels = [&vel.0, &vel.1, &vel.2, &vel.3, &vel.4, &vel.5];
+                for (k, axis) in [Axis::X, Axis::Y, Axis::Z].into_iter().enumerate() {
+                    let name = format!("{}.{}", jb.body_name, axis_name(axis));
+                    self.coordinate(
+                        w,
+                        jb,
+                        ElementaryKind::Translation(axis),
+                        name,
+                        inits[k],
+                        vels[k],
+                        "init",
+                        "vel",
+                    );
+                }
+                let lower = order.to_ascii_lowercase();
+                let mut axes = Vec::new();
+                for c in lower.chars() {
+                    match c {
+                        'x' => axes.push(Axis::X),
+                        'y' => axes.push(Axis::Y),
+                        'z' => axes.push(Axis::Z),
+                        _ => {}
+                    }
+                }
+                let permutation = lower.len() == 3
+                    && axes.len() == 3
+                    && axes.contains(&Axis::X)
+                    && axes.contains(&Axis::Y)
+                    && axes.contains(&Axis::Z);
+                if !permutation {
+                    self.err(
+                        w,
+                        Some("order"),
+                        Some(order),
+                        format!("rotation order must be a permutation of \"xyz\", got \"{order}\""),
+                    );
+                    return;
+                }
+                for axis in axes {
+                    let name = format!("{}.r{}", jb.body_name, axis_name(axis));
+                    let k = 3 + axis.index();
+                    self.coordinate(
+                        w,
+                        jb,
+                        ElementaryKind::Rotation(axis),
+                        name,
+                        inits[k],
+                        vels[k],
+                        "init",
+                        "vel",
+                    );
+                }
+            }
+            RawJoint::Rigid { at, rotation, .. } => {
+                self.fixed3(w, jb, true, "at", at);
+                self.fixed3(w, jb, false, "rotation", rotation);
+            }
+            RawJoint::Joint { transforms, .. } => {
+                for (k, t) in transforms.iter().enumerate() {
+                    let (kind, arg, tn) = match t {
+                        RawTransform::Tx(a) => (ElementaryKind::Translation(Axis::X), a, "Tx"),
+                        RawTransform::Ty(a) => (ElementaryKind::Translation(Axis::Y), a, "Ty"),
+                        RawTransform::Tz(a) => (ElementaryKind::Translation(Axis::Z), a, "Tz"),
+                        RawTransform::Rx(a) => (ElementaryKind::Rotation(Axis::X), a, "Rx"),
+                        RawTransform::Ry(a) => (ElementaryKind::Rotation(Axis::Y), a, "Ry"),
+                        RawTransform::Rz(a) => (ElementaryKind::Rotation(Axis::Z), a, "Rz"),
+                    };
+                    match arg {
+                        TransformArg::Value(v) => {
+                            let label = format!("joint transform {} ({tn})", k + 1);
+                            let e = self.expr(w, &label, tn, v, true);
+                            let motion = if e.has_time() {
+                                Motion::Time(e)
+                            } else {
+                                Motion::Fixed(e)
+                            };
+                            jb.joint.push(Elementary { kind, motion });
+                        }
+                        TransformArg::Coord { coord, init, vel } => {
+                            self.coordinate(w, jb, kind, coord.clone(), init, vel, "init", "vel");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+struct JointBuilder<'a> {
+    body: usize,
+    body_name: &'a str,
+    joint: Vec<Elementary>,
+    coords: Vec<Coordinate>,
+}
+
+struct Lookup<'a> {
+    names: HashMap<&'a str, usize>,
+    raw_to_new: Vec<Option<usize>>,
+}
+
+impl Cx<'_> {
+    fn body_ref(&mut self, w: &Where, key: &str, name: &str, lookup: &Lookup) -> BodyRef {
+        if name == "ground" {
+            return BodyRef::Ground;
+        }
+        match lookup.names.get(name) {
+            Some(&i) => match lookup.raw_to_new[i] {
+                Some(k) => BodyRef::Body(k),
+                // The body is invalid (reported where it is defined).
+                None => BodyRef::Ground,
+            },
+            None => {
+                self.err(
+                    w,
+                    Some(key),
+                    Some(name),
+                    format!("unknown body \"{name}\" in {key}"),
+                );
+                BodyRef::Ground
+            }
+        }
+    }
+
+    fn frame(&mut self, w: &Where, point_key: &str, rot_key: &str, p: &Vec3, r: &Vec3) -> Frame {
+        Frame {
+            origin: self.vec3(w, point_key, p, false),
+            rotation_xyz: self.vec3(w, rot_key, r, false),
+        }
+    }
+
+    fn cut_joints(&mut self, raw: &RawModel, lookup: &Lookup) -> Vec<CutJoint> {
+        let mut out: Vec<CutJoint> = Vec::new();
+        for (i, c) in raw.cut_joints.iter().enumerate() {
+            let nth = raw.cut_joints[..i]
+                .iter()
+                .filter(|o| o.name == c.name)
+                .count();
+            let w = Where::Elem(CUT, c.name.clone(), nth);
+            if nth > 0 {
+                self.err(&w, Some("name"), None, "duplicate cut joint name".into());
+                continue;
+            }
+            let body1 = self.body_ref(&w, "body1", &c.body1, lookup);
+            let body2 = self.body_ref(&w, "body2", &c.body2, lookup);
+            let frame1 = self.frame(&w, "point1", "rotation1", &c.point1, &c.rotation1);
+            let frame2 = self.frame(&w, "point2", "rotation2", &c.point2, &c.rotation2);
+            if c.constrain.is_empty() {
+                self.err(
+                    &w,
+                    Some("constrain"),
+                    None,
+                    "constrains no component: list at least one of Tx, Ty, Tz, Rx, Ry, Rz in constrain".into(),
+                );
+            }
+            let mut constrained = Vec::new();
+            for comp in &c.constrain {
+                let comp = match comp {
+                    RawComponent::Tx => Component::Tx,
+                    RawComponent::Ty => Component::Ty,
+                    RawComponent::Tz => Component::Tz,
+                    RawComponent::Rx => Component::Rx,
+                    RawComponent::Ry => Component::Ry,
+                    RawComponent::Rz => Component::Rz,
+                };
+                if constrained.contains(&comp) {
+                    self.err(
+                        &w,
+                        Some("constrain"),
+                        None,
+                        format!("component {comp:?} is constrained twice"),
+                    );
+                } else {
+                    constrained.push(comp);
+                }
+            }
+            if c.body1 == c.body2 {
+                self.err(
+                    &w,
+                    Some("body2"),
+                    None,
+                    format!("connects body \"{}\" to itself", c.body1),
+                );
+            }
+            out.push(CutJoint {
+                name: c.name.clone(),
+                body1,
+                frame1,
+                body2,
+                frame2,
+                constrained,
+            });
+        }
+        out
+    }
+
+    fn matrix6(&mut self, w: &Where, key: &str, m: &RawMatrix6) -> Box<[Expr; 36]> {
+        let mut out: Box<[Expr; 36]> = Box::new(std::array::from_fn(|_| Expr::Num(0.0)));
+        match m {
+            RawMatrix6::Diag(d) => {
+                let d = self.vec6(w, key, d);
+                for (k, e) in d.into_iter().enumerate() {
+                    out[7 * k] = e;
+                }
+            }
+            RawMatrix6::Full(v) => {
+                if v.len() != 36 {
+                    self.err(
+                        w,
+                        Some(key),
+                        None,
+                        format!(
+                            "{key} must have 36 values (6×6, row-major), got {}",
+                            v.len()
+                        ),
+                    );
+                }
+                for (k, x) in v.iter().take(36).enumerate() {
+                    out[k] = self.expr(w, &format!("{key}[{}][{}]", k / 6, k % 6), key, x, false);
+                }
+            }
+        }
+        out
+    }
+
+    fn forces(&mut self, raw: &RawModel, lookup: &Lookup) -> Vec<ForceElement> {
+        let mut out = Vec::new();
+        for (i, f) in raw.forces.iter().enumerate() {
+            let name = f.name();
+            let nth = raw.forces[..i].iter().filter(|o| o.name() == name).count();
+            let w = Where::Elem(FORCE, name.to_string(), nth);
+            if nth > 0 {
+                self.err(&w, Some("name"), None, "duplicate force name".into());
+                continue;
+            }
+            if name.is_empty() {
+                self.err(
+                    &w,
+                    Some("name"),
+                    None,
+                    "a force needs a non-empty name".into(),
+                );
+            }
+            let kind = match f {
+                RawForce::Spring {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    c,
+                    d,
+                    f0,
+                    x0,
+                    ..
+                } => ForceKind::Bipolar {
+                    body1: self.body_ref(&w, "body1", body1, lookup),
+                    point1: self.vec3(&w, "point1", point1, false),
+                    body2: self.body_ref(&w, "body2", body2, lookup),
+                    point2: self.vec3(&w, "point2", point2, false),
+                    stiffness: self.expr(&w, "c", "c", c, false),
+                    damping: self.expr(&w, "d", "d", d, false),
+                    preload: self.expr(&w, "f0", "f0", f0, false),
+                    free_length: self.expr(&w, "x0", "x0", x0, false),
+                },
+                RawForce::Linear6 {
+                    body1,
+                    point1,
+                    rotation1,
+                    body2,
+                    point2,
+                    rotation2,
+                    stiffness,
+                    damping,
+                    preload,
+                    ..
+                } => {
+                    let body1 = self.body_ref(&w, "body1", body1, lookup);
+                    let frame1 = self.frame(&w, "point1", "rotation1", point1, rotation1);
+                    let body2 = self.body_ref(&w, "body2", body2, lookup);
+                    let frame2 = self.frame(&w, "point2", "rotation2", point2, rotation2);
+                    let stiffness = self.matrix6(&w, "stiffness", stiffness);
+                    let damping = self.matrix6(&w, "damping", damping);
+                    let preload = self.vec6(&w, "preload", preload);
+                    ForceKind::Linear6 {
+                        body1,
+                        frame1,
+                        body2,
+                        frame2,
+                        stiffness,
+                        damping,
+                        preload,
+                    }
+                }
+                RawForce::Applied {
+                    body,
+                    point,
+                    force,
+                    torque,
+                    frame,
+                    ..
+                } => {
+                    let body = match self.body_ref(&w, "body", body, lookup) {
+                        BodyRef::Body(k) => k,
+                        BodyRef::Ground => {
+                            if body == "ground" {
+                                self.err(
+                                    &w,
+                                    Some("body"),
+                                    None,
+                                    "an applied force acts on a body, not on ground".into(),
+                                );
+                            }
+                            0
+                        }
+                    };
+                    ForceKind::Applied {
+                        body,
+                        point: self.vec3(&w, "point", point, false),
+                        force: self.vec3(&w, "force", force, true),
+                        torque: self.vec3(&w, "torque", torque, true),
+                        frame: match frame {
+                            RawFrame::Body => VectorFrame::Body,
+                            RawFrame::Global => VectorFrame::Global,
+                        },
+                    }
+                }
+            };
+            out.push(ForceElement {
+                name: name.to_string(),
+                kind,
+            });
+        }
+        out
+    }
+}
+
+/// Every dependency cycle among parameter defaults (each once, as indices in order).
+pub(crate) fn find_cycles(exprs: &[Expr]) -> Vec<Vec<usize>> {
+    let deps: Vec<Vec<usize>> = exprs.iter().map(Expr::params_used).collect();
+    let n = exprs.len();
+    let mut state = vec![0u8; n];
+    let mut stack = Vec::new();
+    let mut cycles: Vec<Vec<usize>> = Vec::new();
+    fn visit(
+        i: usize,
+        deps: &[Vec<usize>],
+        state: &mut [u8],
+        stack: &mut Vec<usize>,
+        cycles: &mut Vec<Vec<usize>>,
+    ) {
+        state[i] = 1;
+        stack.push(i);
+        for &j in &deps[i] {
+            if j >= state.len() {
+                continue;
+            }
+            match state[j] {
+                0 => visit(j, deps, state, stack, cycles),
+                1 => {
+                    let k = stack.iter().position(|&s| s == j).unwrap_or(0);
+                    let cycle = stack[k..].to_vec();
+                    let mut key = cycle.clone();
+                    key.sort_unstable();
+                    if !cycles.iter().any(|c| {
+                        let mut s = c.clone();
+                        s.sort_unstable();
+                        s == key
+                    }) {
+                        cycles.push(cycle);
+                    }
+                }
+                _ => {}
+            }
+        }
+        stack.pop();
+        state[i] = 2;
+    }
+    for i in 0..n {
+        if state[i] == 0 {
+            visit(i, &deps, &mut state, &mut stack, &mut cycles);
+        }
+    }
+    cycles
+}
+
+/// Evaluates parameter expressions in dependency order; `Err(cycle)` on a cycle.
+pub(crate) fn evaluate_parameters(exprs: &[Expr]) -> Result<Vec<f64>, Vec<usize>> {
+    if let Some(c) = find_cycles(exprs).into_iter().next() {
+        return Err(c);
+    }
+    let n = exprs.len();
+    let mut values = vec![f64::NAN; n];
+    let mut done = vec![false; n];
+    fn eval(i: usize, exprs: &[Expr], values: &mut [f64], done: &mut [bool]) {
+        if done[i] {
+            return;
+        }
+        for j in exprs[i].params_used() {
+            if j < exprs.len() {
+                eval(j, exprs, values, done);
+            }
+        }
+        values[i] = exprs[i].eval(values, 0.0);
+        done[i] = true;
+    }
+    for i in 0..n {
+        eval(i, exprs, &mut values, &mut done);
+    }
+    Ok(values)
+}
+
+/// Eigenvalues of a symmetric 3×3 matrix, ascending (closed form, O. K. Smith,
+/// "Eigenvalues of a symmetric 3 × 3 matrix", CACM 4(4), 1961).
+pub(crate) fn sym3_eigenvalues(a: [[f64; 3]; 3]) -> [f64; 3] {
+    let p1 = a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2);
+    let mut ev = if p1 == 0.0 {
+        [a[0][0], a[1][1], a[2][2]]
+    } else {
+        let q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+        let p2 = (a[0][0] - q).powi(2) + (a[1][1] - q).powi(2) + (a[2][2] - q).powi(2) + 2.0 * p1;
+        let p = (p2 / 6.0).sqrt();
+        let b = |i: usize, j: usize| (a[i][j] - if i == j { q } else { 0.0 }) / p;
+        let det = b(0, 0) * (b(1, 1) * b(2, 2) - b(1, 2) * b(2, 1))
+            - b(0, 1) * (b(1, 0) * b(2, 2) - b(1, 2) * b(2, 0))
+            + b(0, 2) * (b(1, 0) * b(2, 1) - b(1, 1) * b(2, 0));
+        let r = (det / 2.0).clamp(-1.0, 1.0);
+        let phi = r.acos() / 3.0;
+        let e1 = q + 2.0 * p * phi.cos();
+        let e3 = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+        [e1, 3.0 * q - e1 - e3, e3]
+    };
+    ev.sort_by(f64::total_cmp);
+    ev
+}
