@@ -288,16 +288,14 @@ impl Cx<'_> {
         if self.errors.is_empty()
             && let Ok(values) = evaluate_parameters(&exprs)
         {
-            {
-                for (i, v) in values.iter().enumerate() {
-                    if !v.is_finite() {
-                        let w = Where::Param(self.names[i].clone());
-                        self.err(&w, None, None, format!("default value is not finite: {v}"));
-                    }
+            for (i, v) in values.iter().enumerate() {
+                if !v.is_finite() {
+                    let w = Where::Param(self.names[i].clone());
+                    self.err(&w, None, None, format!("default value is not finite: {v}"));
                 }
-                if values.iter().all(|v| v.is_finite()) {
-                    self.defaults = Some(values);
-                }
+            }
+            if values.iter().all(|v| v.is_finite()) {
+                self.defaults = Some(values);
             }
         }
         let params = kept

@@ -85,3 +85,308 @@ pub struct Scenario {
     /// `-o` overrides it.
     pub output_file: Option<PathBuf>,
 }
+
+use crate::error::{ModelError, ModelErrors};
+use crate::load::ron_error;
+use crate::locate::Locator;
+use crate::model::Model;
+use crate::raw::{OrderedMap, Value};
+use serde::{Deserialize, Deserializer};
+use std::path::Path;
+
+fn some<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Scenario", deny_unknown_fields)]
+struct RawScenario {
+    model: String,
+    #[serde(default)]
+    macros: Vec<String>,
+    #[serde(default)]
+    parameters: OrderedMap<Value>,
+    #[serde(default)]
+    initial: Vec<RawInitial>,
+    end_time: f64,
+    integrator: RawIntegrator,
+    output: RawOutput,
+    #[serde(default, deserialize_with = "some")]
+    output_file: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInitial {
+    coord: String,
+    #[serde(default, deserialize_with = "some")]
+    value: Option<f64>,
+    #[serde(default, deserialize_with = "some")]
+    velocity: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+enum RawIntegrator {
+    Rk4 {
+        step: f64,
+    },
+    Park {
+        rtol: f64,
+        atol: f64,
+        max_step: f64,
+        #[serde(default, deserialize_with = "some")]
+        initial_step: Option<f64>,
+        #[serde(default)]
+        jacobian: JacobianKind,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    interval: f64,
+    #[serde(default = "yes")]
+    coordinates: bool,
+    #[serde(default)]
+    velocities: bool,
+    #[serde(default)]
+    bodies: Vec<String>,
+    #[serde(default)]
+    forces: Vec<String>,
+}
+
+/// Reads a scenario file. The model path and the output file are resolved
+/// relative to the scenario file's folder. Names of macros, parameters and
+/// coordinates are checked against the model by [`Scenario::parameter_values`]
+/// and [`Scenario::initial_state`].
+pub fn load_scenario(path: &Path) -> Result<Scenario, ModelErrors> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", format!("cannot read the scenario file: {e}")))?;
+    parse_scenario(&text, path)
+}
+
+/// Resolves scenario text; `path` is the scenario file (for errors and relative paths).
+pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> {
+    let loc = Locator::new(text);
+    let raw: RawScenario = ron::Options::default()
+        .from_str(text)
+        .map_err(|e| ron_error(&loc, path, e))?;
+    let mut errors = Vec::new();
+    let mut check = |ok: bool, key: &str, message: String| {
+        if !ok {
+            let position = loc
+                .top()
+                .and_then(|top| loc.key_anywhere(top, key))
+                .map(|k| loc.pos(k));
+            errors.push(ModelError {
+                file: path.to_path_buf(),
+                element: String::new(),
+                message,
+                position,
+            });
+        }
+    };
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    check(
+        positive(raw.end_time),
+        "end_time",
+        format!(
+            "end_time must be positive and finite, got {} s",
+            raw.end_time
+        ),
+    );
+    let integrator = match raw.integrator {
+        RawIntegrator::Rk4 { step } => {
+            check(
+                positive(step),
+                "step",
+                format!("integrator step must be positive and finite, got {step} s"),
+            );
+            IntegratorSpec::Rk4 { step }
+        }
+        RawIntegrator::Park {
+            rtol,
+            atol,
+            max_step,
+            initial_step,
+            jacobian,
+        } => {
+            check(
+                positive(rtol),
+                "rtol",
+                format!("integrator rtol must be positive and finite, got {rtol}"),
+            );
+            check(
+                positive(atol),
+                "atol",
+                format!("integrator atol must be positive and finite, got {atol}"),
+            );
+            check(
+                positive(max_step),
+                "max_step",
+                format!("integrator max_step must be positive and finite, got {max_step} s"),
+            );
+            if let Some(h) = initial_step {
+                check(
+                    positive(h),
+                    "initial_step",
+                    format!("integrator initial_step must be positive and finite, got {h} s"),
+                );
+            }
+            IntegratorSpec::Park {
+                rtol,
+                atol,
+                max_step,
+                initial_step,
+                jacobian,
+            }
+        }
+    };
+    check(
+        positive(raw.output.interval),
+        "interval",
+        format!(
+            "output interval must be positive and finite, got {} s",
+            raw.output.interval
+        ),
+    );
+    for init in &raw.initial {
+        for (what, x) in [("value", init.value), ("velocity", init.velocity)] {
+            if let Some(x) = x {
+                check(
+                    x.is_finite(),
+                    what,
+                    format!("initial {what} of \"{}\" is not finite: {x}", init.coord),
+                );
+            }
+        }
+        check(
+            init.value.is_some() || init.velocity.is_some(),
+            "initial",
+            format!(
+                "initial condition of \"{}\" sets neither value nor velocity",
+                init.coord
+            ),
+        );
+    }
+    let mut parameters: Vec<(String, String)> = Vec::new();
+    for (name, v) in raw.parameters.0 {
+        check(
+            !parameters.iter().any(|(n, _)| n == &name),
+            "parameters",
+            format!("parameter \"{name}\" is overridden twice"),
+        );
+        let text = match v {
+            Value::Num(x) => {
+                check(
+                    x.is_finite(),
+                    "parameters",
+                    format!("parameter \"{name}\" is not finite: {x}"),
+                );
+                format!("{x:?}")
+            }
+            Value::Text(s) => s,
+        };
+        parameters.push((name, text));
+    }
+    if !errors.is_empty() {
+        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        return Err(ModelErrors(errors));
+    }
+    let dir = path.parent().unwrap_or(Path::new(""));
+    Ok(Scenario {
+        source: path.to_path_buf(),
+        model: dir.join(&raw.model),
+        macros: raw.macros,
+        parameters,
+        initial: raw
+            .initial
+            .into_iter()
+            .map(|i| InitialOverride {
+                coordinate: i.coord,
+                value: i.value,
+                velocity: i.velocity,
+            })
+            .collect(),
+        end_time: raw.end_time,
+        integrator,
+        output: OutputSpec {
+            interval: raw.output.interval,
+            coordinates: raw.output.coordinates,
+            velocities: raw.output.velocities,
+            bodies: raw.output.bodies,
+            forces: raw.output.forces,
+        },
+        output_file: raw.output_file.map(|f| dir.join(f)),
+    })
+}
+
+impl Scenario {
+    /// Locates a string literal (a macro, parameter or coordinate name) in the
+    /// scenario file, if the file can still be read.
+    fn locate(&self, literal: &str) -> Option<(usize, usize)> {
+        let text = std::fs::read_to_string(&self.source).ok()?;
+        let loc = Locator::new(&text);
+        let top = loc.top()?;
+        loc.string_in(top, literal).map(|k| loc.pos(k))
+    }
+
+    fn scenario_error(&self, mut e: ModelError, literal: &str) -> ModelError {
+        e.file = self.source.clone();
+        e.position = self.locate(literal);
+        e
+    }
+
+    /// Parameter values of `model` with this scenario's macros and overrides;
+    /// errors (unknown macro or parameter, bad value) name the scenario file.
+    pub fn parameter_values(&self, model: &Model) -> Result<Vec<f64>, ModelErrors> {
+        model
+            .parameter_values(&self.macros, &self.parameters)
+            .map_err(|e| {
+                let literal = e.element.split('"').nth(1).unwrap_or_default().to_string();
+                ModelErrors(vec![self.scenario_error(e, &literal)])
+            })
+    }
+
+    /// Initial coordinates and velocities of `model` for parameter values
+    /// `params`, with this scenario's initial overrides applied. Every unknown
+    /// coordinate name is reported.
+    pub fn initial_state(
+        &self,
+        model: &Model,
+        params: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), ModelErrors> {
+        let (mut q, mut v) = model.initial_state(params);
+        let mut errors = Vec::new();
+        for init in &self.initial {
+            match model.coordinate_index(&init.coordinate) {
+                Some(i) => {
+                    if let Some(x) = init.value {
+                        q[i] = x;
+                    }
+                    if let Some(x) = init.velocity {
+                        v[i] = x;
+                    }
+                }
+                None => {
+                    let e = ModelError::new(
+                        &self.source,
+                        format!("initial \"{}\"", init.coordinate),
+                        format!("unknown coordinate of model \"{}\"", model.name),
+                    );
+                    errors.push(self.scenario_error(e, &init.coordinate));
+                }
+            }
+        }
+        if errors.is_empty() {
+            Ok((q, v))
+        } else {
+            Err(ModelErrors(errors))
+        }
+    }
+}
