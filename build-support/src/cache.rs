@@ -96,8 +96,13 @@ pub fn write_source(dir: &Path, file_name: &str, contents: &str) -> Result<PathB
 /// Atomic write of `bytes` to `dest` (whose parent directory must exist).
 pub(crate) fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), BuildError> {
     let dir = dest.parent().unwrap_or(Path::new("."));
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".tmp-write-")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tmp-write-");
+    // An ordinary file, not a private temporary one: 0o666 minus the umask (usually 0o644),
+    // as `std::fs::write` would create it. tempfile's default would be 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder
         .tempfile_in(dir)
         .map_err(|e| BuildError::io(dir, e))?;
     tmp.write_all(bytes)
@@ -136,6 +141,15 @@ mod tests {
         let p = write_source(&out, "lib.rs", "fn a() {}").unwrap();
         assert_eq!(p, out.join("lib.rs"));
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "fn a() {}");
+        #[cfg(unix)]
+        {
+            // Same mode as a file created by std::fs::write (0o666 minus the umask).
+            use std::os::unix::fs::PermissionsExt;
+            let reference = dir.path().join("reference");
+            std::fs::write(&reference, "x").unwrap();
+            let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+            assert_eq!(mode(&p), mode(&reference));
+        }
         // Overwrite, and no temporary file left behind.
         write_source(&out, "lib.rs", "fn b() {}").unwrap();
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "fn b() {}");

