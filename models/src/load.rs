@@ -75,8 +75,9 @@ enum Where {
     Top,
     /// Constructors, name, occurrence (0 = first element with that name).
     Elem(&'static [&'static str], String, usize),
-    Param(String),
-    Macro(String),
+    /// Name, occurrence.
+    Param(String, usize),
+    Macro(String, usize),
 }
 
 impl Where {
@@ -84,8 +85,8 @@ impl Where {
         match self {
             Where::Top => String::new(),
             Where::Elem(c, n, _) => format!("{} \"{n}\"", kind_of(c[0])),
-            Where::Param(n) => format!("parameter \"{n}\""),
-            Where::Macro(n) => format!("macro \"{n}\""),
+            Where::Param(n, _) => format!("parameter \"{n}\""),
+            Where::Macro(n, _) => format!("macro \"{n}\""),
         }
     }
 }
@@ -119,15 +120,15 @@ impl Cx<'_> {
                 }
                 found
             }
-            Where::Param(n) => {
+            Where::Param(n, nth) => {
                 let map = self.loc.field_group(self.loc.top()?, "parameters")?;
-                let k = self.loc.map_entry(map, n)?;
+                let k = self.loc.map_entry(map, n, *nth)?;
                 Some((k, k + 3))
             }
-            Where::Macro(n) => {
+            Where::Macro(n, nth) => {
                 let map = self.loc.field_group(self.loc.top()?, "macros")?;
-                let k = self.loc.map_entry(map, n)?;
-                let (_, close) = self.loc.map_entry_group(map, n)?;
+                let k = self.loc.map_entry(map, n, *nth)?;
+                let (_, close) = self.loc.group_after(k + 2)?;
                 Some((k, close))
             }
         }
@@ -242,8 +243,12 @@ impl Cx<'_> {
 
     fn parameters(&mut self, raw: &RawModel) -> (Vec<Parameter>, Vec<Expr>) {
         let mut kept = Vec::new();
-        for (name, pv) in &raw.parameters.0 {
-            let w = Where::Param(name.clone());
+        for (i, (name, pv)) in raw.parameters.0.iter().enumerate() {
+            let nth = raw.parameters.0[..i]
+                .iter()
+                .filter(|(n, _)| n == name)
+                .count();
+            let w = Where::Param(name.clone(), nth);
             if !is_identifier(name) {
                 self.err(
                     &w,
@@ -269,7 +274,7 @@ impl Cx<'_> {
             .iter()
             .zip(self.names.clone())
             .map(|(pv, name)| {
-                let w = Where::Param(name);
+                let w = Where::Param(name, 0);
                 self.expr(&w, "the default value", "", &pv.value, false)
             })
             .collect();
@@ -277,7 +282,7 @@ impl Cx<'_> {
         for cycle in &cycles {
             let mut path: Vec<&str> = cycle.iter().map(|&i| self.names[i].as_str()).collect();
             path.push(path[0]);
-            let w = Where::Param(self.names[cycle[0]].clone());
+            let w = Where::Param(self.names[cycle[0]].clone(), 0);
             self.err(
                 &w,
                 None,
@@ -290,7 +295,7 @@ impl Cx<'_> {
         {
             for (i, v) in values.iter().enumerate() {
                 if !v.is_finite() {
-                    let w = Where::Param(self.names[i].clone());
+                    let w = Where::Param(self.names[i].clone(), 0);
                     self.err(&w, None, None, format!("default value is not finite: {v}"));
                 }
             }
@@ -313,8 +318,9 @@ impl Cx<'_> {
 
     fn macros(&mut self, raw: &RawModel) -> Vec<Macro> {
         let mut out: Vec<Macro> = Vec::new();
-        for (name, assigns) in &raw.macros.0 {
-            let w = Where::Macro(name.clone());
+        for (i, (name, assigns)) in raw.macros.0.iter().enumerate() {
+            let nth = raw.macros.0[..i].iter().filter(|(n, _)| n == name).count();
+            let w = Where::Macro(name.clone(), nth);
             if out.iter().any(|m| &m.name == name) {
                 self.err(&w, None, None, "duplicate macro name".into());
                 continue;
@@ -432,7 +438,7 @@ impl Cx<'_> {
                         Some("parent"),
                         None,
                         format!(
-                            "loop in the body tree (each body's parent follows it): {}",
+                            "loop in the body tree (body -> its parent): {}",
                             names.join(" -> ")
                         ),
                     );

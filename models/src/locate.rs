@@ -170,17 +170,19 @@ impl<'a> Locator<'a> {
             .nth(nth)
     }
 
-    /// The key string `"name":` directly inside the map group `span`.
-    pub(crate) fn map_entry(&self, span: Span, name: &str) -> Option<usize> {
-        self.children(span).into_iter().find(|&k| {
-            matches!(&self.toks[k].0, Tok::Str(s) if s == name)
-                && matches!(self.toks.get(k + 1), Some((Tok::Punct(':'), _)))
-        })
+    /// The `nth` key string `"name":` directly inside the map group `span`.
+    pub(crate) fn map_entry(&self, span: Span, name: &str, nth: usize) -> Option<usize> {
+        self.children(span)
+            .into_iter()
+            .filter(|&k| {
+                matches!(&self.toks[k].0, Tok::Str(s) if s == name)
+                    && matches!(self.toks.get(k + 1), Some((Tok::Punct(':'), _)))
+            })
+            .nth(nth)
     }
 
-    /// The group of the value of the map entry `"name": { … }` inside `span`.
-    pub(crate) fn map_entry_group(&self, span: Span, name: &str) -> Option<Span> {
-        let k = self.map_entry(span, name)? + 2;
+    /// The group opening at token `k`.
+    pub(crate) fn group_after(&self, k: usize) -> Option<Span> {
         Some((k, self.close.get(k).copied().flatten()?))
     }
 

@@ -190,7 +190,7 @@ pub(crate) struct RawBody {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(rename = "Inertia", deny_unknown_fields)]
 pub(crate) struct RawInertia {
     pub ixx: Value,
     pub iyy: Value,
@@ -204,7 +204,7 @@ pub(crate) struct RawInertia {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(rename = "Joint", deny_unknown_fields)]
 pub(crate) enum RawJoint {
     Revolute {
         parent: String,
@@ -330,6 +330,7 @@ impl<'de> Deserialize<'de> for TransformArg {
 }
 
 #[derive(Debug, Deserialize)]
+#[serde(rename = "Transform")]
 pub(crate) enum RawTransform {
     Tx(TransformArg),
     Ty(TransformArg),
@@ -340,6 +341,7 @@ pub(crate) enum RawTransform {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename = "Component")]
 pub(crate) enum RawComponent {
     Tx,
     Ty,
@@ -367,12 +369,14 @@ pub(crate) struct RawCutJoint {
 }
 
 #[derive(Debug, Deserialize)]
+#[serde(rename = "Matrix6")]
 pub(crate) enum RawMatrix6 {
     Diag(Vec6),
     Full(Vec<Value>),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename = "Frame")]
 pub(crate) enum RawFrame {
     #[default]
     Global,
@@ -382,7 +386,7 @@ pub(crate) enum RawFrame {
 // Raw syntax lives only while a file is resolved; size does not matter.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(rename = "Force", deny_unknown_fields)]
 pub(crate) enum RawForce {
     Spring {
         name: String,
