@@ -140,9 +140,9 @@ impl fmt::Display for OpCounts {
 /// Hashable form of an operand for value numbering.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 enum OpKey {
-    Tmp(u32),
-    Sym(Symbol),
     Const(u64),
+    Sym(Symbol),
+    Tmp(u32),
 }
 
 fn key(o: Operand) -> OpKey {

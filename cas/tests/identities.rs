@@ -1,0 +1,508 @@
+//! Unit tests of each simplification rule, of differentiation against hand-derived derivatives,
+//! of substitution, evaluation errors and the straight-line program.
+//!
+//! Expected values are textbook identities and derivatives, or numbers computed here by hand.
+
+use railmbs_cas::{
+    CasError, Context, ExprId, Func, Instr, Node, ONE, Operand, Program, Symbol, Values, ZERO,
+};
+
+fn xyz(ctx: &mut Context) -> (ExprId, ExprId, ExprId) {
+    (ctx.q(0), ctx.q(1), ctx.q(2))
+}
+
+#[test]
+fn hash_consing_and_commutativity() {
+    let mut c = Context::new();
+    let (x, y, z) = xyz(&mut c);
+    assert_eq!(c.q(0), x, "a symbol is one node");
+    let a = c.add(x, y);
+    let b = c.add(y, x);
+    assert_eq!(a, b);
+    let a = c.mul(x, y);
+    let b = c.mul(y, x);
+    assert_eq!(a, b);
+    // flattening: (x + y) + z = x + (y + z), (x·y)·z = x·(y·z)
+    let xy = c.add(x, y);
+    let l = c.add(xy, z);
+    let yz = c.add(y, z);
+    let r = c.add(x, yz);
+    assert_eq!(l, r);
+    let xy = c.mul(x, y);
+    let l = c.mul(xy, z);
+    let yz = c.mul(y, z);
+    let r = c.mul(x, yz);
+    assert_eq!(l, r);
+    assert!(matches!(c.node(l), Node::Mul { factors } if factors.len() == 3));
+    let n = c.len();
+    let _ = c.mul_many(&[z, y, x]);
+    assert_eq!(
+        c.len(),
+        n,
+        "rebuilding an existing expression creates no node"
+    );
+}
+
+#[test]
+fn constant_folding() {
+    let mut c = Context::new();
+    let two = c.num(2.0);
+    let three = c.num(3.0);
+    let s = c.add(two, three);
+    assert_eq!(c.as_num(s), Some(5.0));
+    let p = c.mul(two, three);
+    assert_eq!(c.as_num(p), Some(6.0));
+    let d = c.div(three, two);
+    assert_eq!(c.as_num(d), Some(1.5));
+    let q = c.powi(two, -2);
+    assert_eq!(c.as_num(q), Some(0.25));
+    let s0 = c.sin(ZERO);
+    assert_eq!(s0, ZERO);
+    let c0 = c.cos(ZERO);
+    assert_eq!(c0, ONE);
+    let four = c.num(4.0);
+    let r = c.sqrt(four);
+    assert_eq!(c.as_num(r), Some(2.0));
+    let e0 = c.exp(ZERO);
+    assert_eq!(e0, ONE);
+    let l1 = c.ln(ONE);
+    assert_eq!(l1, ZERO);
+    let m = c.num(-1.0);
+    let at = c.atan2(ONE, m);
+    assert_eq!(c.as_num(at), Some(3.0 * std::f64::consts::FRAC_PI_4));
+    // not folded: the result would not be finite
+    let l = c.ln(m);
+    assert!(matches!(c.node(l), Node::Call(Func::Ln, _)));
+    let negzero = c.num(-0.0);
+    assert_eq!(negzero, ZERO);
+}
+
+#[test]
+fn zero_one_identities() {
+    let mut c = Context::new();
+    let (x, _, _) = xyz(&mut c);
+    assert_eq!(c.add(x, ZERO), x);
+    assert_eq!(c.mul(x, ONE), x);
+    assert_eq!(c.mul(x, ZERO), ZERO);
+    assert_eq!(c.powi(x, 0), ONE);
+    assert_eq!(c.powi(x, 1), x);
+    assert_eq!(c.scale(1.0, x), x);
+    assert_eq!(c.scale(0.0, x), ZERO);
+    assert_eq!(c.sub(x, x), ZERO);
+    assert_eq!(c.div(x, x), ONE);
+    let nx = c.neg(x);
+    assert_eq!(c.neg(nx), x);
+}
+
+#[test]
+fn like_terms_and_factors() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let x2 = c.scale(2.0, x);
+    let x3 = c.scale(3.0, x);
+    let s = c.add(x2, x3);
+    assert_eq!(s, c.scale(5.0, x));
+    let xx = c.mul(x, x);
+    assert_eq!(xx, c.powi(x, 2));
+    let xxx = c.mul(xx, x);
+    assert_eq!(xxx, c.powi(x, 3));
+    // x²·y / (x·y) = x
+    let xxy = c.mul(xx, y);
+    let xy = c.mul(x, y);
+    assert_eq!(c.div(xxy, xy), x);
+    // (x·y)² = x²·y² (integer powers of products distribute)
+    let p = c.powi(xy, 2);
+    let y2 = c.powi(y, 2);
+    assert_eq!(p, c.mul(xx, y2));
+    // numeric factors are pulled out: (2x)·(3y) = 6·(x·y)
+    let y3 = c.scale(3.0, y);
+    let m = c.mul(x2, y3);
+    assert_eq!(m, c.scale(6.0, xy));
+    // a number times a sum distributes: 2(x + y) = 2x + 2y
+    let xpy = c.add(x, y);
+    let l = c.scale(2.0, xpy);
+    let y2t = c.scale(2.0, y);
+    assert_eq!(l, c.add(x2, y2t));
+    // x·y + 2·y·x = 3xy
+    let yx2 = c.scale(2.0, xy);
+    let s = c.add(xy, yx2);
+    assert_eq!(s, c.scale(3.0, xy));
+}
+
+#[test]
+fn odd_and_even_functions() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let nx = c.neg(x);
+    let s = c.sin(nx);
+    let sx = c.sin(x);
+    assert_eq!(s, c.neg(sx));
+    assert_eq!(c.cos(nx), c.cos(x));
+    let t = c.tan(nx);
+    let tx = c.tan(x);
+    assert_eq!(t, c.neg(tx));
+    assert_eq!(c.abs(nx), c.abs(x));
+    let ax = c.abs(x);
+    assert_eq!(c.abs(ax), ax);
+    // sin(x − y) = −sin(y − x), cos(x − y) = cos(y − x)
+    let a = c.sub(x, y);
+    let b = c.sub(y, x);
+    let sa = c.sin(a);
+    let sb = c.sin(b);
+    assert_eq!(sa, c.neg(sb));
+    assert_eq!(c.cos(a), c.cos(b));
+    // sin(−2x) = −sin(2x)
+    let m2x = c.scale(-2.0, x);
+    let p2x = c.scale(2.0, x);
+    let s1 = c.sin(m2x);
+    let s2 = c.sin(p2x);
+    assert_eq!(s1, c.neg(s2));
+}
+
+#[test]
+fn sqrt_exp_ln_rules() {
+    let mut c = Context::new();
+    let (x, _, _) = xyz(&mut c);
+    let x2 = c.powi(x, 2);
+    assert_eq!(c.sqrt(x2), c.abs(x));
+    let r = c.sqrt(x);
+    let rr = c.mul(r, r);
+    assert_eq!(rr, x);
+    let r3 = c.powi(r, 3);
+    assert_eq!(r3, c.mul(x, r));
+    let l = c.ln(x);
+    assert_eq!(c.exp(l), x);
+    let e = c.exp(x);
+    assert_eq!(c.ln(e), x);
+}
+
+#[test]
+fn pythagoras_plain_and_with_monomial() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let s = c.sin(x);
+    let co = c.cos(x);
+    let s2 = c.powi(s, 2);
+    let c2 = c.powi(co, 2);
+    assert_eq!(c.add(s2, c2), ONE);
+    // m·l²·sin²x + m·l²·cos²x = m·l²
+    let m = c.p(0);
+    let l = c.p(1);
+    let l2 = c.powi(l, 2);
+    let ml2 = c.mul(m, l2);
+    let a = c.mul_many(&[ml2, s2]);
+    let b = c.mul_many(&[ml2, c2]);
+    assert_eq!(c.add(a, b), ml2);
+    // 3·y·sin²x + 3·y·cos²x + y = 4y
+    let ys = c.mul(y, s2);
+    let yc = c.mul(y, c2);
+    let t = c.sum(0.0, &[(ys, 3.0), (yc, 3.0), (y, 1.0)]);
+    assert_eq!(t, c.scale(4.0, y));
+    // sin⁴x + sin²x·cos²x = sin²x (remainder after removing sin² matches cos²·sin²)
+    let s4 = c.powi(s, 4);
+    let s2c2 = c.mul(s2, c2);
+    assert_eq!(c.add(s4, s2c2), s2);
+    // different coefficients are left alone (documented): 2sin²x + cos²x stays a sum
+    let t = c.sum(0.0, &[(s2, 2.0), (c2, 1.0)]);
+    assert!(matches!(c.node(t), Node::Add { terms, .. } if terms.len() == 2));
+}
+
+type Mat = Vec<Vec<ExprId>>;
+
+fn matmul(c: &mut Context, a: &Mat, b: &Mat) -> Mat {
+    let n = a.len();
+    let m = b[0].len();
+    (0..n)
+        .map(|i| {
+            (0..m)
+                .map(|j| {
+                    let ps: Vec<ExprId> = (0..b.len()).map(|k| c.mul(a[i][k], b[k][j])).collect();
+                    c.add_many(&ps)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn transpose(a: &Mat) -> Mat {
+    (0..a[0].len())
+        .map(|j| (0..a.len()).map(|i| a[i][j]).collect())
+        .collect()
+}
+
+/// Elementary rotation matrices (frame rotation about z or x by angle a, rad).
+fn rot_z(c: &mut Context, a: ExprId) -> Mat {
+    let (s, co) = (c.sin(a), c.cos(a));
+    let ms = c.neg(s);
+    vec![vec![co, ms, ZERO], vec![s, co, ZERO], vec![ZERO, ZERO, ONE]]
+}
+
+fn rot_x(c: &mut Context, a: ExprId) -> Mat {
+    let (s, co) = (c.sin(a), c.cos(a));
+    let ms = c.neg(s);
+    vec![vec![ONE, ZERO, ZERO], vec![ZERO, co, ms], vec![ZERO, s, co]]
+}
+
+fn assert_identity(c: &Context, m: &Mat) {
+    for (i, row) in m.iter().enumerate() {
+        for (j, &e) in row.iter().enumerate() {
+            assert_eq!(
+                e,
+                if i == j { ONE } else { ZERO },
+                "entry ({i},{j}): {}",
+                c.display(e)
+            );
+        }
+    }
+}
+
+#[test]
+fn rotation_transpose_times_rotation_is_identity() {
+    let mut c = Context::new();
+    let (a, b, g) = xyz(&mut c);
+    let rz = rot_z(&mut c, a);
+    let p = matmul(&mut c, &transpose(&rz), &rz);
+    assert_identity(&c, &p);
+    // a product of two elementary rotations, as recursive kinematics builds it: its entries
+    // are monomials, so RᵀR = I needs no expansion
+    let rx = rot_x(&mut c, b);
+    let r = matmul(&mut c, &rz, &rx);
+    let p = matmul(&mut c, &transpose(&r), &r);
+    assert_identity(&c, &p);
+    let p = matmul(&mut c, &r, &transpose(&r));
+    assert_identity(&c, &p);
+    // three rotations: entries of R are sums, so RᵀR has squares of sums; after the explicit
+    // `expand` the repeated sin²+cos² rule reduces every entry to 0 or 1
+    let rz2 = rot_z(&mut c, g);
+    let r3 = matmul(&mut c, &r, &rz2);
+    let p = matmul(&mut c, &transpose(&r3), &r3);
+    let p: Mat = p
+        .iter()
+        .map(|row| row.iter().map(|&e| c.expand(e)).collect())
+        .collect();
+    assert_identity(&c, &p);
+}
+
+#[test]
+fn derivatives_of_elementary_functions() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let sx = Symbol::q(0);
+    let s = c.sin(x);
+    assert_eq!(c.diff(s, sx), c.cos(x));
+    let co = c.cos(x);
+    let ds = c.diff(co, sx);
+    assert_eq!(ds, c.neg(s));
+    let x3 = c.powi(x, 3);
+    let x2 = c.powi(x, 2);
+    let d = c.diff(x3, sx);
+    assert_eq!(d, c.scale(3.0, x2));
+    let xy = c.mul(x, y);
+    assert_eq!(c.diff(xy, sx), y);
+    assert_eq!(c.diff(y, sx), ZERO);
+    let r = c.recip(x);
+    let d = c.diff(r, sx);
+    let xm2 = c.powi(x, -2);
+    assert_eq!(d, c.neg(xm2));
+    let e = c.exp(x);
+    assert_eq!(c.diff(e, sx), e);
+    let l = c.ln(x);
+    assert_eq!(c.diff(l, sx), c.recip(x));
+    // chain rule: d sin(x²) = 2x·cos(x²)
+    let sx2 = c.sin(x2);
+    let d = c.diff(sx2, sx);
+    let cx2 = c.cos(x2);
+    let e2 = c.mul(x, cx2);
+    assert_eq!(d, c.scale(2.0, e2));
+    // memoized: a second call returns the same node without creating any
+    let n = c.len();
+    assert_eq!(c.diff(sx2, sx), d);
+    assert_eq!(c.len(), n);
+    // numeric checks at a point for tan, sqrt, abs, atan2 (hand-derived values)
+    let t = c.tan(x);
+    let rt = c.sqrt(x);
+    let ab = c.abs(x);
+    let at = c.atan2(y, x);
+    let ds: Vec<ExprId> = [t, rt, ab, at].iter().map(|&e| c.diff(e, sx)).collect();
+    let dy = c.diff(at, Symbol::q(1));
+    let (xv, yv) = (0.7_f64, -0.4_f64);
+    let vals = Values {
+        q: &[xv, yv],
+        ..Default::default()
+    };
+    let got = c.eval(&[ds[0], ds[1], ds[2], ds[3], dy], &vals).unwrap();
+    let r2 = xv * xv + yv * yv;
+    let want = [
+        1.0 / xv.cos().powi(2),
+        0.5 / xv.sqrt(),
+        1.0,
+        -yv / r2,
+        xv / r2,
+    ];
+    for (g, w) in got.iter().zip(want) {
+        // a few roundings apart: 4 ulp relative
+        assert!((g - w).abs() <= 4.0 * f64::EPSILON * w.abs(), "{g} vs {w}");
+    }
+}
+
+#[test]
+fn jacobian_and_substitution() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    // f = (x·y, sin x + y²)
+    let f0 = c.mul(x, y);
+    let s = c.sin(x);
+    let y2 = c.powi(y, 2);
+    let f1 = c.add(s, y2);
+    let j = c.jacobian(&[f0, f1], &[Symbol::q(0), Symbol::q(1)]);
+    let cx = c.cos(x);
+    let y2x = c.scale(2.0, y);
+    assert_eq!(j, vec![vec![y, x], vec![cx, y2x]]);
+    // substitute x → y + 1 simultaneously with y → x: (y+1)·x
+    let yp1 = c.sum(1.0, &[(y, 1.0)]);
+    let out = c.subs(&[f0], &[(Symbol::q(0), yp1), (Symbol::q(1), x)]);
+    assert_eq!(out[0], c.mul(yp1, x));
+    // substituting a number folds: sin(0) = 0
+    let out = c.subs(&[f1], &[(Symbol::q(0), ZERO)]);
+    assert_eq!(out[0], y2);
+}
+
+#[test]
+fn expand_products_of_sums() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let s = c.add(x, y);
+    let s2 = c.powi(s, 2);
+    let e = c.expand(s2);
+    let x2 = c.powi(x, 2);
+    let y2 = c.powi(y, 2);
+    let xy = c.mul(x, y);
+    assert_eq!(e, c.sum(0.0, &[(x2, 1.0), (xy, 2.0), (y2, 1.0)]));
+}
+
+#[test]
+fn evaluation_errors_are_reported() {
+    let mut c = Context::new();
+    let (x, _, _) = xyz(&mut c);
+    let p3 = c.q(3);
+    let err = c
+        .eval(
+            &[p3],
+            &Values {
+                q: &[1.0],
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
+    assert_eq!(
+        err,
+        CasError::MissingValue {
+            symbol: Symbol::q(3),
+            len: 1
+        }
+    );
+    let r = c.recip(x);
+    let err = c
+        .eval(
+            &[r],
+            &Values {
+                q: &[0.0],
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
+    assert!(matches!(err, CasError::NonFinite { .. }), "{err}");
+    let prog = Program::compile(&c, &[r]);
+    let err = prog
+        .eval(&Values {
+            q: &[0.0],
+            ..Default::default()
+        })
+        .unwrap_err();
+    assert!(matches!(err, CasError::NonFinite { .. }), "{err}");
+    let m1 = c.num(-1.0);
+    let l = c.ln(m1);
+    assert!(c.eval(&[l], &Values::default()).is_err());
+    assert!(prog.split(0).is_err());
+}
+
+#[test]
+fn program_shares_and_lowers() {
+    let mut c = Context::new();
+    let (x, y, z) = xyz(&mut c);
+    // out0 = x·y + z, out1 = (x·y)·sin(z), out2 = x⁴ − 2y, out3 = x²/y
+    let xy = c.mul(x, y);
+    let o0 = c.add(xy, z);
+    let sz = c.sin(z);
+    let o1 = c.mul(xy, sz);
+    let x4 = c.powi(x, 4);
+    let o2 = c.sum(0.0, &[(x4, 1.0), (y, -2.0)]);
+    let x2 = c.powi(x, 2);
+    let o3 = c.div(x2, y);
+    let prog = Program::compile(&c, &[o0, o1, o2, o3]);
+    // x·y once; x² = x·x once (shared by x⁴ = x²·x² and x²/y); x·y·sin z as one product chain
+    let counts = prog.op_counts();
+    // x·y, +z, sin z, (x·y)·sin z ... hand count: muls: x·y, x·y·sin z (chain of 3 factors: 2
+    // muls, the first x·y shared), x², x⁴, 2y; adds: +z, −2y; divs: x²/y; calls: sin
+    assert_eq!(counts.calls, 1);
+    assert_eq!(counts.divs, 1);
+    assert_eq!(counts.adds, 2);
+    assert_eq!(counts.muls, 5, "{prog}");
+    let tree = c.tree_op_counts(&[o0, o1, o2, o3]);
+    assert!(tree.total() > counts.total());
+    let q = [0.3, -1.2, 2.5];
+    let vals = Values {
+        q: &q,
+        ..Default::default()
+    };
+    let a = prog.eval(&vals).unwrap();
+    let b = c.eval(&[o0, o1, o2, o3], &vals).unwrap();
+    for (u, v) in a.iter().zip(&b) {
+        // the same operations in the same order, up to the order of commutative operands
+        assert!((u - v).abs() <= 4.0 * f64::EPSILON * v.abs(), "{u} vs {v}");
+    }
+    // pure negation: −x·y is one Neg; −3x is one multiplication by −3, no Neg
+    let nxy = c.neg(xy);
+    let m3x = c.scale(-3.0, x);
+    let p = Program::compile(&c, &[nxy, m3x]);
+    assert_eq!(p.instrs.len(), 3, "{p}");
+    assert!(p.instrs.contains(&Instr::Mul(
+        Operand::Const(-3.0),
+        Operand::Sym(Symbol::q(0))
+    )));
+    // sin/cos pairing info
+    let cz = c.cos(z);
+    let p = Program::compile(&c, &[sz, cz]);
+    assert_eq!(p.sin_cos_pairs().len(), 1);
+    assert_eq!(p.symbols(), vec![Symbol::q(2)]);
+}
+
+#[test]
+fn split_program_matches_and_reuses_slots() {
+    let mut c = Context::new();
+    let qs: Vec<ExprId> = (0..6).map(|i| c.q(i)).collect();
+    let mut outs = Vec::new();
+    let mut acc = ONE;
+    for &q in &qs {
+        let s = c.sin(q);
+        acc = c.mul(acc, s);
+        let o = c.add(acc, q);
+        outs.push(o);
+    }
+    let prog = Program::compile(&c, &outs);
+    let q: Vec<f64> = (0..6).map(|i| 0.3 + 0.2 * i as f64).collect();
+    let vals = Values {
+        q: &q,
+        ..Default::default()
+    };
+    let want = prog.eval(&vals).unwrap();
+    let last = prog.last_uses();
+    assert_eq!(last.len(), prog.instrs.len());
+    for max in 1..=prog.instrs.len() + 1 {
+        let sp = prog.split(max).unwrap();
+        assert!(sp.chunks.iter().all(|ch| ch.instrs.len() <= max));
+        let got = sp.eval(&prog, &vals).unwrap();
+        assert_eq!(got, want, "max {max}");
+        assert!(sp.n_slots <= prog.instrs.len());
+    }
+}
