@@ -6,6 +6,149 @@
 //! the element and the RON line and column. The result is a [`Model`] (or a
 //! [`Scenario`]) that both engines — the numeric-iterative `runtime` and the
 //! symbolic `codegen` — consume.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! let model = railmbs_models::load_model(Path::new("models/mechanisms/double_pendulum.ron"))
+//!     .unwrap_or_else(|errors| panic!("{errors}")); // one located error per line
+//! let params = model.parameter_values(&["heavy".to_string()], &[("l1".into(), "2".into())])?;
+//! let (q0, v0) = model.initial_state(&params);
+//! # Ok::<(), railmbs_models::ModelError>(())
+//! ```
+//!
+//! ## Model files
+//!
+//! Units are SI (m, kg, s, N, rad). The inertial frame is `ground` (x forward,
+//! y left, z up); a body frame has its origin at the body's centre of mass.
+//! `//` and `/* */` comments are allowed. A complete example using every construct:
+//!
+//! ```ron
+//! Model(
+//!     name: "double_pendulum",
+//!     description: "Two links, a slider and a wheelset", // optional
+//!     // Parameters (identifiers), in file order. A value is a number, expression
+//!     // text over other parameters, or (value: …, doc: "…"). They stay symbolic in
+//!     // the resolved model: runtime inputs of compiled plugins.
+//!     parameters: {
+//!         "l1": 1.0, "m1": 1.0, "l2": "l1", "m2": (value: 2, doc: "kg"), "m3": 0.5,
+//!         "g": 9.81, "k": 1000, "d": 5, "L0": 0.5, "WS1.r0": 0.46,
+//!     },
+//!     // Named sets of assignments (optional), applied by scenarios.
+//!     macros: { "heavy": { "m1": 2.0, "m2": "2*m1" } },
+//!     gravity: (0, "-g", 0),                   // optional, default (0, 0, -9.81)
+//!     bodies: [                                 // any order: sorted parent-first
+//!         Body(
+//!             name: "link1",
+//!             mass: "m1",
+//!             // About the centre of mass, body frame; ixy, ixz, iyz default 0.
+//!             inertia: (ixx: "m1*l1^2/12", iyy: 1e-4, izz: "m1*l1^2/12"),
+//!             joint: Revolute(parent: "ground", at: (0, 0, 0), axis: Z,
+//!                             coord: "q0", init: 0.5, vel: 0.0, to_com: (0, "-l1/2", 0)),
+//!         ),
+//!         Body(
+//!             name: "link2", mass: "m2", inertia: (ixx: 0.1, iyy: 0.1, izz: 0.1),
+//!             joint: Joint(parent: "link1", transforms: [
+//!                 Ty("-l1/2"),                             // fixed
+//!                 Rz((coord: "q1", init: 0.0, vel: 0.0)),  // generalized coordinate
+//!                 Rx("0.1*sin(2*pi*t)"),                   // function of time
+//!                 Ty("-l2/2"),
+//!             ]),
+//!         ),
+//!         Body(
+//!             name: "slider", mass: "m3", inertia: (ixx: 1e-3, iyy: 1e-3, izz: 1e-3),
+//!             joint: Prismatic(parent: "ground", axis: X, coord: "s", init: "L0"),
+//!         ),
+//!         Body(
+//!             name: "WS1", mass: 1200, inertia: (ixx: 700, iyy: 100, izz: 700),
+//!             // Coordinates WS1.x, WS1.y, WS1.z, then WS1.rz, WS1.rx, WS1.ry.
+//!             joint: SixDof(parent: "ground", at: (0, 0, "WS1.r0"), order: "zxy",
+//!                           vel: (10, 0, 0, 0, "10/WS1.r0", 0)),
+//!         ),
+//!         Body(
+//!             name: "axlebox", mass: 50, inertia: (ixx: 1, iyy: 1, izz: 1),
+//!             joint: Rigid(parent: "WS1", at: (0, 1, 0), rotation: (0, 0, 0)),
+//!         ),
+//!     ],
+//!     cut_joints: [                             // optional
+//!         CutJoint(name: "closure", body1: "link2", point1: (0, "-l2/2", 0), rotation1: (0, 0, 0),
+//!                  body2: "ground", point2: (2.0, 0, 0), constrain: [Tx, Ty]),
+//!     ],
+//!     forces: [                                 // optional
+//!         Spring(name: "k1", body1: "ground", point1: (0, 0, 0), body2: "slider", point2: (0, 0, 0),
+//!                c: "k", d: "d", f0: 0, x0: "L0"),
+//!         Linear6(name: "bush", body1: "WS1", point1: (0, 1, 0), rotation1: (0, 0, 0),
+//!                 body2: "axlebox", point2: (0, 0, 0), rotation2: (0, 0, 0),
+//!                 stiffness: Diag((1e6, 1e6, 1e6, 1e3, 1e3, 1e3)),
+//!                 damping: Full([1e3, 0, 0, 0, 0, 0,   0, 1e3, 0, 0, 0, 0,   0, 0, 1e3, 0, 0, 0,
+//!                                0, 0, 0, 10, 0, 0,    0, 0, 0, 0, 10, 0,    0, 0, 0, 0, 0, 10]),
+//!                 preload: (0, 0, 0, 0, 0, 0)),
+//!         Applied(name: "push", body: "slider", point: (0, 0, 0), force: ("10*sin(t)", 0, 0),
+//!                 torque: (0, 0, 0), frame: Global),
+//!     ],
+//! )
+//! ```
+//!
+//! ### Numbers and expressions
+//!
+//! Every numeric field accepts an integer, a float or an expression string with
+//! `+ - * / ^` (`^` is right-associative and binds tighter than unary minus:
+//! `-x^2 = -(x^2)`), parentheses, `sin cos tan sqrt abs exp ln atan`, `pi`,
+//! numbers (`1`, `1.5`, `1e-3`) and parameter names (letters, digits, `_` and
+//! `.`, e.g. `WS1.r0`). Time `t` (s) is allowed only in the elementary
+//! transforms of `Joint(...)` (making them rheonomic, [`Motion::Time`]) and in
+//! the `force` and `torque` of `Applied`. See [`parser`].
+//!
+//! ### Joints
+//!
+//! A joint is the ordered list of elementary transformations (`Tx Ty Tz Rx Ry
+//! Rz`, along or about the axes of the current moving frame) from the parent's
+//! body frame to the child's. Shorthands (fixed components that are literally 0
+//! are dropped):
+//!
+//! | shorthand | expands to | coordinate names |
+//! |---|---|---|
+//! | `Revolute(parent, at, axis, coord, init, vel, to_com)` | `Tx Ty Tz`(at), `R<axis>`(coord), `Tx Ty Tz`(to_com) | `coord`, default `<body>.r<axis>` |
+//! | `Prismatic(...)`, same fields | `Tx Ty Tz`(at), `T<axis>`(coord), `Tx Ty Tz`(to_com) | `coord`, default `<body>.t<axis>` |
+//! | `SixDof(parent, at, order, init, vel)` | `Tx Ty Tz`(at), `Tx Ty Tz` coordinates, rotations in `order` (default `"xyz"`) | `<body>.x .y .z .rx .ry .rz` |
+//! | `Rigid(parent, at, rotation)` | `Tx Ty Tz`(at), `Rx Ry Rz`(rotation) | none |
+//! | `Joint(parent, transforms: [...])` | as written: `Tx(value)` fixed or with `t`, `Tx((coord: "q", init: …, vel: …))` a coordinate | as given |
+//!
+//! `at` is the joint point in the parent frame and `to_com` the vector from the
+//! joint point to the child's centre of mass in the child frame (both default
+//! zero). SixDof `init` and `vel` are `(x, y, z, about x, about y, about z)`.
+//! Coordinates are numbered in body order (parents first), then transform order.
+//!
+//! ### Validation
+//!
+//! All problems are reported together ([`ModelErrors`]), each as
+//! `file:line:column: element: message`, e.g.
+//! `models/mechanisms/x.ron:12:9: body "link2": mass must be positive, got -1`:
+//! RON syntax, unknown fields, unknown identifiers and bodies, duplicate names
+//! (bodies, coordinates, forces, cut joints, parameters, macros), loops in the
+//! body tree, cycles among parameter defaults, `t` where not allowed, values
+//! that are not finite with the default parameters, non-positive masses,
+//! inertia tensors that are not positive definite or whose principal moments
+//! violate the triangle inequality, cut joints constraining nothing.
+//!
+//! ## Scenario files
+//!
+//! ```ron
+//! Scenario(
+//!     model: "../mechanisms/double_pendulum.ron",   // relative to this file
+//!     macros: ["heavy"],                            // optional
+//!     parameters: { "l1": 2.0, "k": "2*g" },        // optional overrides
+//!     initial: [(coord: "q0", value: 0.3), (coord: "q1", velocity: 1.0)],   // optional
+//!     end_time: 10.0,
+//!     integrator: Park(rtol: 1e-6, atol: 1e-8, max_step: 0.01, initial_step: 1e-4,
+//!                      jacobian: FiniteDifference),  // or Rk4(step: 0.001)
+//!     output: (interval: 0.01, coordinates: true, velocities: false, bodies: [], forces: []),
+//!     output_file: "double_pendulum.csv",           // optional, relative to this file
+//! )
+//! ```
+//!
+//! [`load_scenario`] checks the numbers; [`Scenario::parameter_values`] and
+//! [`Scenario::initial_state`] check macro, parameter and coordinate names
+//! against the model, with errors located in the scenario file.
 
 mod error;
 pub mod expr;
