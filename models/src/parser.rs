@@ -92,6 +92,7 @@ pub fn parse_expr_with(
         text,
         chars: text.chars().collect(),
         pos: 0,
+        depth: 0,
         allow_time,
         resolve,
     };
@@ -108,9 +109,15 @@ struct Parser<'a, R> {
     text: &'a str,
     chars: Vec<char>,
     pos: usize,
+    /// Current nesting depth of `unary` (every recursion passes through it).
+    depth: usize,
     allow_time: bool,
     resolve: R,
 }
+
+/// Deepest nesting of parentheses, signs and powers accepted, so that
+/// pathological text gives an error instead of overflowing the stack.
+const MAX_DEPTH: usize = 200;
 
 impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
     fn peek(&self) -> Option<char> {
@@ -186,6 +193,18 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
     }
 
     fn unary(&mut self) -> Result<Expr, ParseError> {
+        if self.depth >= MAX_DEPTH {
+            return Err(self.syntax(&format!(
+                "at most {MAX_DEPTH} levels of nested parentheses, signs and powers"
+            )));
+        }
+        self.depth += 1;
+        let result = self.unary_inner();
+        self.depth -= 1;
+        result
+    }
+
+    fn unary_inner(&mut self) -> Result<Expr, ParseError> {
         if self.eat('-') {
             Ok(Expr::Neg(Box::new(self.unary()?)))
         } else if self.eat('+') {

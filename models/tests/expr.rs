@@ -187,6 +187,18 @@ fn display_round_trips() {
     assert_eq!(back.eval(&P, 0.0), e.eval(&P, 0.0));
 }
 
+#[test]
+fn deep_nesting_is_an_error_not_a_crash() {
+    let deep = format!("{}1{}", "(".repeat(100_000), ")".repeat(100_000));
+    let e = parse_expr(&deep, &[], false).unwrap_err();
+    assert!(e.to_string().contains("nested"), "{e}");
+    let e = parse_expr(&"-".repeat(100_000), &[], false).unwrap_err();
+    assert!(e.to_string().contains("nested"), "{e}");
+    // Reasonable nesting is fine.
+    let ok = format!("{}1{}", "(".repeat(50), ")".repeat(50));
+    assert_eq!(parse_expr(&ok, &[], false).unwrap(), Expr::Num(1.0));
+}
+
 fn arb_expr() -> impl Strategy<Value = Expr> {
     let leaf = prop_oneof![
         (-1e3f64..1e3).prop_map(Expr::Num),
@@ -212,6 +224,15 @@ fn same_value(x: f64, y: f64) -> bool {
 }
 
 proptest! {
+    /// Arbitrary text never panics: it parses or gives an error with a column inside it.
+    #[test]
+    fn arbitrary_text_parses_or_errors(text in "[-+*/^() .0-9a-zA-Z_eE]{0,40}") {
+        match parse_expr(&text, &names(), true) {
+            Ok(e) => { let _ = e.eval(&P, 0.5); }
+            Err(err) => prop_assert!(err.column >= 1 && err.column <= text.chars().count() + 1),
+        }
+    }
+
     #[test]
     fn random_trees_display_and_reparse_to_equal_values(e in arb_expr(), t in -3.0f64..3.0) {
         let n = names();

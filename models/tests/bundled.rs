@@ -1,0 +1,50 @@
+//! Every bundled model and scenario file loads without errors.
+
+use railmbs_models::*;
+use std::path::{Path, PathBuf};
+
+fn ron_files(folder: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+#[test]
+fn bundled_models_load() {
+    let mut problems = Vec::new();
+    for folder in ["mechanisms", "vehicles"] {
+        for path in ron_files(folder) {
+            match load_model(&path) {
+                Ok(m) => {
+                    let p = m.default_parameter_values();
+                    assert!(p.iter().all(|x| x.is_finite()), "{}", path.display());
+                }
+                Err(e) => problems.push(e.to_string()),
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn bundled_scenarios_resolve() {
+    let mut problems = Vec::new();
+    for path in ron_files("scenarios") {
+        let resolved = load_scenario(&path).and_then(|sc| {
+            let model = load_model(&sc.model)?;
+            let p = sc.parameter_values(&model)?;
+            sc.initial_state(&model, &p).map(|_| ())
+        });
+        if let Err(e) = resolved {
+            problems.push(e.to_string());
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
