@@ -188,12 +188,13 @@ impl<'a> Locator<'a> {
 
     /// The first `key:` anywhere inside `span`.
     pub(crate) fn key_anywhere(&self, span: Span, key: &str) -> Option<usize> {
-        (span.0..span.1).find(|&k| self.is_key(k, key))
+        (span.0..span.1.min(self.toks.len())).find(|&k| self.is_key(k, key))
     }
 
     /// The first string literal with exactly this content inside `span`.
     pub(crate) fn string_in(&self, span: Span, text: &str) -> Option<usize> {
-        (span.0..span.1).find(|&k| matches!(&self.toks[k].0, Tok::Str(s) if s == text))
+        (span.0..span.1.min(self.toks.len()))
+            .find(|&k| matches!(&self.toks[k].0, Tok::Str(s) if s == text))
     }
 
     /// The constructor token before a group (the element's start), or the group itself.

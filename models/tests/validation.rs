@@ -330,3 +330,45 @@ fn all_errors_are_collected_and_sorted() {
     // One error per line in the display.
     assert_eq!(errs.to_string().lines().count(), 4);
 }
+
+#[test]
+fn model_level_and_macro_errors() {
+    let errs = base_errors(
+        "\"k\": 10 },",
+        "\"k\": 10 },\n    gravity: (0, 0, \"-gg\"),",
+    );
+    let e = find(&errs, "", "unknown identifier \"gg\" in gravity.z");
+    assert_eq!(e.line(), Some(4));
+    let errs = base_errors(
+        "\"k\": 10 },",
+        "\"k\": 10 },\n    macros: { \"heavy\": { \"mass\": 3 } },",
+    );
+    let e = find(&errs, "macro \"heavy\"", "unknown parameter \"mass\"");
+    assert_eq!(e.line(), Some(4));
+    let errs = base_errors(
+        "\"k\": 10 },",
+        "\"k\": 10 },\n    macros: { \"heavy\": { \"m\": \"2*t\" } },",
+    );
+    find(&errs, "macro \"heavy\"", "time t is not allowed");
+}
+
+#[test]
+fn cut_joint_to_itself_and_time_in_applied_point() {
+    let errs = base_errors(
+        "body2: \"ground\", point2: (1, 0, 0)",
+        "body2: \"b\", point2: (1, 0, 0)",
+    );
+    find(&errs, "cut joint \"cj\"", "connects body \"b\" to itself");
+    let errs = base_errors(
+        "c: \"k\"),",
+        "c: \"k\"),\n        Applied(name: \"f\", body: \"a\", point: (\"t\", 0, 0), force: (\"sin(t)\", 0, 0)),",
+    );
+    let e = find(&errs, "force \"f\"", "time t is not allowed in point.x");
+    assert_eq!(errs.len(), 1, "t in force is allowed: {errs}");
+    let text = BASE.replacen(
+        "c: \"k\"),",
+        "c: \"k\"),\n        Applied(name: \"f\", body: \"a\", point: (\"t\", 0, 0), force: (\"sin(t)\", 0, 0)),",
+        1,
+    );
+    assert_eq!(e.line(), Some(line_of(&text, "point: (\"t\"")));
+}
