@@ -210,10 +210,9 @@ impl Cx<'_> {
     }
 
     fn resolve(&mut self, raw: RawModel) -> Model {
-        let (parameters, default_exprs) = self.parameters(&raw);
+        let parameters = self.parameters(&raw);
         let macros = self.macros(&raw);
         let gravity = self.vec3(&Where::Top, "gravity", &raw.gravity, false);
-        let _ = default_exprs;
         let (bodies, coordinates, raw_to_new) = self.bodies(&raw);
         let body_names: HashMap<&str, usize> = raw
             .bodies
@@ -241,7 +240,9 @@ impl Cx<'_> {
         }
     }
 
-    fn parameters(&mut self, raw: &RawModel) -> (Vec<Parameter>, Vec<Expr>) {
+    /// Parameters in file order; sets `self.names` and, when they can all be
+    /// evaluated, `self.defaults`.
+    fn parameters(&mut self, raw: &RawModel) -> Vec<Parameter> {
         let mut kept = Vec::new();
         for (i, (name, pv)) in raw.parameters.0.iter().enumerate() {
             let nth = raw.parameters.0[..i]
@@ -303,17 +304,15 @@ impl Cx<'_> {
                 self.defaults = Some(values);
             }
         }
-        let params = kept
-            .iter()
+        kept.iter()
             .zip(&self.names)
-            .zip(&exprs)
-            .map(|((pv, name), e)| Parameter {
+            .zip(exprs)
+            .map(|((pv, name), default)| Parameter {
                 name: name.clone(),
-                default: e.clone(),
+                default,
                 doc: pv.doc.clone(),
             })
-            .collect();
-        (params, exprs)
+            .collect()
     }
 
     fn macros(&mut self, raw: &RawModel) -> Vec<Macro> {
@@ -330,6 +329,9 @@ impl Cx<'_> {
                 match self.names.iter().position(|n| n == pname) {
                     Some(i) => {
                         let e = self.expr(&w, &format!("the value of \"{pname}\""), "", v, false);
+                        if assignments.iter().any(|(j, _)| *j == i) {
+                            self.err(&w, None, Some(pname), format!("assigns \"{pname}\" twice"));
+                        }
                         assignments.push((i, e));
                     }
                     None => self.err(
@@ -657,10 +659,11 @@ impl Cx<'_> {
             initial,
             initial_velocity,
         });
-        let index = usize::MAX; // patched by the caller's coordinate numbering
+        // The global coordinate index is set by `bodies` once the coordinate's
+        // name is known to be unique.
         jb.joint.push(Elementary {
             kind,
-            motion: Motion::Coordinate(index),
+            motion: Motion::Coordinate(usize::MAX),
         });
     }
 

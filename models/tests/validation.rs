@@ -206,6 +206,12 @@ fn duplicate_names() {
         "\"k\": 10 },\n    macros: { \"x\": { \"m\": 1 }, \"x\": { \"m\": 2 } },",
     );
     find(&errs, "macro \"x\"", "duplicate macro name");
+
+    let errs = base_errors(
+        "\"k\": 10 },",
+        "\"k\": 10 },\n    macros: { \"x\": { \"m\": 1, \"m\": 2 } },",
+    );
+    find(&errs, "macro \"x\"", "assigns \"m\" twice");
 }
 
 #[test]
