@@ -156,10 +156,12 @@ impl Model {
     }
 
     /// Hex BLAKE3 hash of the model's structure: bodies, joints, every
-    /// expression, coordinates, forces, cut joints, gravity and parameter names
-    /// — but not the parameters' default values, their docs, the macros, the
+    /// expression, coordinates (names and places), forces, cut joints, gravity
+    /// and parameter names — but not the parameters' default values, their
+    /// docs, the macros, the coordinates' initial values and velocities, the
     /// model's name or its source file. A compiled plugin stays valid when only
-    /// default values change, since parameters are its runtime inputs.
+    /// those inputs change: parameters are its runtime inputs and the initial
+    /// state is taken from the model by the runtime.
     pub fn structural_hash(&self) -> String {
         let mut hasher = blake3::Hasher::new();
         hasher.update(self.canonical_structure().as_bytes());
@@ -177,6 +179,10 @@ impl Model {
         for p in &mut stripped.parameters {
             p.default = Expr::Num(0.0);
             p.doc.clear();
+        }
+        for c in &mut stripped.coordinates {
+            c.initial = Expr::Num(0.0);
+            c.initial_velocity = Expr::Num(0.0);
         }
         format!("railmbs-model-structure-v1\n{stripped:?}")
     }

@@ -107,6 +107,9 @@ fn structural_hash_ignores_default_values() {
         ("(value: 2, doc: \"kg\")", "(value: 3, doc: \"kilogram\")"),
         ("description: \"test model\"", "description: \"changed\""),
         ("\"m2\": \"2*m1\"", "\"m2\": \"3*m1\""),
+        // Initial conditions are inputs too.
+        ("init: 0.5", "init: 0.25"),
+        ("init: \"0.1*l1\", vel: 2", "init: \"0.2*l1\", vel: 3"),
     ] {
         assert!(FULL.contains(from), "{from}");
         let m = load(&FULL.replacen(from, to, 1)).unwrap();
@@ -127,7 +130,6 @@ fn structural_hash_changes_with_structure() {
         ("c: \"k\"", "c: \"d\""),
         ("frame: Body", "frame: Global"),
         ("gravity: (0, \"-g\", 0)", "gravity: (0, 0, \"-g\")"),
-        ("init: 0.5", "init: 0.25"),
     ] {
         assert!(FULL.contains(from), "{from}");
         let m = load(&FULL.replacen(from, to, 1)).unwrap_or_else(|e| panic!("{e}"));
