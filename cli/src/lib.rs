@@ -6,3 +6,5 @@
 
 pub mod conicity;
 pub mod creep;
+pub mod engine;
+pub mod run;

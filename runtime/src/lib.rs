@@ -1,9 +1,19 @@
 //! # railmbs-runtime
 //!
-//! The simulator's library: numeric-iterative equations of motion, force
-//! elements, integrators (Park's implicit method, RK4), plugin loading, outputs.
+//! The simulator's library: numeric-iterative equations of motion
+//! ([`numeric`]), force elements ([`forces`]), integrators ([`integrate`]:
+//! Park's implicit method, RK4), and the glue that makes a model with
+//! parameters an integrable system ([`model_system`]).
 
+pub mod equations;
+pub mod forces;
 pub mod integrate;
+pub mod model_system;
+pub mod numeric;
+pub mod simulate;
 pub mod system;
 
+pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
+pub use model_system::ModelSystem;
+pub use numeric::NumericEquations;
 pub use system::{MechanicalSystem, SimError};

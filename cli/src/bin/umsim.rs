@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{conicity, creep};
+use railmbs_cli::{conicity, creep, run};
 
 #[derive(Parser)]
 #[command(name = "umsim", version, about = "railmbs simulator: run scenarios, benchmark engines, wheel-rail tools")]
@@ -12,6 +12,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Simulate a scenario and write its outputs as CSV.
+    Run(run::Args),
     /// Equivalent conicity of a wheelset on a track by EN 15302 (Annex B).
     Conicity(conicity::Args),
     /// Creep forces for a table of contact cases.
@@ -21,6 +23,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Run(a) => run::run(a),
         Command::Conicity(a) => conicity::run(a),
         Command::Creep(a) => creep::run(a),
     };

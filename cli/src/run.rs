@@ -1,0 +1,100 @@
+//! `umsim run SCENARIO.ron [--engine numeric|symbolic] [--plugin FILE] [-o out.csv]`.
+
+use crate::engine::{Engine, build_engine};
+use railmbs_runtime::simulate::{RunSummary, run_scenario};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// Arguments of `umsim run`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Scenario file (RON).
+    pub scenario: PathBuf,
+    /// Which equations of motion to use.
+    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
+    pub engine: Engine,
+    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
+    #[arg(long)]
+    pub plugin: Option<PathBuf>,
+    /// Output CSV (overrides the scenario's `output_file`).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// No progress bar and no summary table.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `umsim run`.
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let scenario = railmbs_models::load_scenario(&args.scenario)?;
+    let model = railmbs_models::load_model(&scenario.model)?;
+    let engine = if args.plugin.is_some() {
+        Engine::Symbolic
+    } else {
+        args.engine
+    };
+    let equations = build_engine(&model, engine, args.plugin.as_deref())?;
+    let output = args.output.clone().or_else(|| scenario.output_file.clone());
+
+    let bar = if !args.quiet && std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} t = {msg} s",
+            )
+            .expect("valid progress template"),
+        );
+        Some(bar)
+    } else {
+        None
+    };
+    let t_end = scenario.end_time;
+    let summary = run_scenario(&scenario, &model, equations, output.as_deref(), |t| {
+        if let Some(b) = &bar {
+            b.set_position((1000.0 * t / t_end) as u64);
+            b.set_message(format!("{t:.3}"));
+        }
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if !args.quiet {
+        print_summary(&summary, output.as_deref());
+    }
+    match summary.error {
+        Some(e) => Err(format!(
+            "{e} (scenario {}; {} output rows up to t = {} s were written{})",
+            args.scenario.display(),
+            summary.rows,
+            summary.t_end,
+            output
+                .as_ref()
+                .map(|p| format!(" to {}", p.display()))
+                .unwrap_or_default()
+        )
+        .into()),
+        None => Ok(()),
+    }
+}
+
+fn print_summary(s: &RunSummary, output: Option<&std::path::Path>) {
+    println!("engine                 {}", s.engine);
+    println!("simulated time         {} s", s.t_end);
+    println!("steps                  {}", s.steps);
+    println!("rejected steps         {}", s.rejected_steps);
+    println!("Newton iterations      {}", s.newton_iterations);
+    println!("Jacobian evaluations   {}", s.jacobian_evaluations);
+    println!("equation evaluations   {}", s.dynamics_evaluations);
+    println!("CPU time               {:.4} s", s.cpu_time);
+    println!("real-time factor       {:.2}", s.realtime_factor());
+    if s.steps > 0 {
+        println!(
+            "CPU time per step      {:.3} µs",
+            1e6 * s.cpu_time / s.steps as f64
+        );
+    }
+    match output {
+        Some(p) => println!("output                 {} ({} rows)", p.display(), s.rows),
+        None => println!("output                 none (give -o FILE or output_file in the scenario)"),
+    }
+}

@@ -1,0 +1,241 @@
+//! A model ready to integrate: an [`Equations`] engine, the runtime force
+//! elements and the parameter values, seen by the integrators as a
+//! [`MechanicalSystem`].
+
+use crate::equations::{Equations, Evaluation, Parts};
+use crate::forces::{self, ForceContext, ForceElement, Wrench};
+use crate::system::{MechanicalSystem, SimError};
+use nalgebra::{DMatrix, DVector};
+use railmbs_models::Model;
+
+/// Equations of motion plus force elements with fixed parameter values.
+pub struct ModelSystem {
+    equations: Box<dyn Equations>,
+    forces: Vec<Box<dyn ForceElement>>,
+    params: Vec<f64>,
+    eval: Evaluation,
+    wrenches: Vec<Wrench>,
+    dynamics_parts: Parts,
+    recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
+}
+
+impl std::fmt::Debug for ModelSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ModelSystem")
+            .field("engine", &self.equations.engine_name())
+            .field("dof", &self.equations.dof())
+            .field("forces", &self.forces.len())
+            .finish()
+    }
+}
+
+impl ModelSystem {
+    /// Combines an engine built for `model` with the model's force elements and
+    /// the parameter values `params` (in `model.parameters` order).
+    pub fn new(
+        model: &Model,
+        mut equations: Box<dyn Equations>,
+        params: Vec<f64>,
+    ) -> Result<Self, SimError> {
+        if equations.dof() != model.coordinates.len()
+            || equations.body_count() != model.bodies.len()
+        {
+            return Err(SimError::Other(format!(
+                "the {} engine has {} coordinates and {} bodies, the model \"{}\" has {} and {}",
+                equations.engine_name(),
+                equations.dof(),
+                equations.body_count(),
+                model.name,
+                model.coordinates.len(),
+                model.bodies.len()
+            )));
+        }
+        equations.set_parameters(&params)?;
+        let mut forces = forces::build(model);
+        for f in &mut forces {
+            f.set_parameters(&params)?;
+        }
+        let eval = Evaluation::for_equations(equations.as_ref());
+        let nb = equations.body_count();
+        let dynamics_parts = Parts {
+            mass: true,
+            bias: true,
+            gravity: true,
+            kinematics: true,
+            jacobians: !forces.is_empty(),
+            constraints: false,
+        };
+        Ok(Self {
+            equations,
+            forces,
+            params,
+            eval,
+            wrenches: vec![Wrench::default(); nb],
+            dynamics_parts,
+            recorder: None,
+        })
+    }
+
+    /// Attaches (or detaches) the output recorder whose pending rows are
+    /// written at every accepted step.
+    pub(crate) fn set_recorder(
+        &mut self,
+        recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
+    ) {
+        self.recorder = recorder;
+    }
+
+    /// The engine.
+    pub fn equations(&self) -> &dyn Equations {
+        self.equations.as_ref()
+    }
+
+    /// The force elements.
+    pub fn forces(&self) -> &[Box<dyn ForceElement>] {
+        &self.forces
+    }
+
+    /// Parameter values in use.
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// Evaluates `parts` at a state and returns the buffers (for outputs and tests).
+    pub fn evaluate(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        parts: Parts,
+    ) -> Result<&Evaluation, SimError> {
+        self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
+        Ok(&self.eval)
+    }
+
+    /// Output values of all force elements at a state (after `evaluate` with
+    /// kinematics), in element order.
+    pub fn force_outputs(&self, t: f64, out: &mut Vec<f64>) {
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+        };
+        for f in &self.forces {
+            f.outputs(&ctx, out);
+        }
+    }
+
+    /// Generalized applied forces Q = Q_g + Σ_j Γ_jᵀ F_j (needs kinematics and
+    /// Jacobians evaluated).
+    fn applied_forces(&mut self, t: f64, out: &mut DVector<f64>) -> Result<(), SimError> {
+        out.copy_from(&self.eval.gravity);
+        if self.forces.is_empty() {
+            return Ok(());
+        }
+        self.wrenches.fill(Wrench::default());
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+        };
+        for f in &self.forces {
+            f.apply(&ctx, &mut self.wrenches)?;
+        }
+        let jac = &self.eval.jacobians;
+        for (j, w) in self.wrenches.iter().enumerate() {
+            let comps = [
+                w.force.x, w.force.y, w.force.z, w.moment.x, w.moment.y, w.moment.z,
+            ];
+            if comps.iter().all(|c| *c == 0.0) {
+                continue;
+            }
+            for (i, qi) in out.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for (k, c) in comps.iter().enumerate() {
+                    s += jac[(6 * j + k, i)] * c;
+                }
+                *qi += s;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl MechanicalSystem for ModelSystem {
+    fn dof(&self) -> usize {
+        self.equations.dof()
+    }
+
+    fn n_constraints(&self) -> usize {
+        self.equations.constraint_count()
+    }
+
+    fn dynamics(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        self.equations
+            .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
+        self.applied_forces(t, force)?;
+        *force -= &self.eval.bias;
+        mass.copy_from(&self.eval.mass);
+        Ok(())
+    }
+
+    fn constraints(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        g: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), SimError> {
+        let v = vec![0.0; q.len()];
+        let parts = Parts {
+            mass: false,
+            bias: false,
+            gravity: false,
+            kinematics: false,
+            jacobians: false,
+            constraints: true,
+        };
+        self.equations.evaluate(t, q, &v, parts, &mut self.eval)?;
+        g.copy_from(&self.eval.constraints);
+        jacobian.copy_from(&self.eval.constraint_jacobian);
+        Ok(())
+    }
+
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {
+        self.accept_forces(t, q, v);
+        if let Some(rec) = self.recorder.take() {
+            rec.borrow_mut().flush(self);
+            self.recorder = Some(rec);
+        }
+    }
+}
+
+impl ModelSystem {
+    fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) {
+        if self.forces.is_empty() {
+            return;
+        }
+        if self
+            .equations
+            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)
+            .is_err()
+        {
+            return;
+        }
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+        };
+        for f in &mut self.forces {
+            f.accept_step(&ctx);
+        }
+    }
+}

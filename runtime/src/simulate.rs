@@ -1,0 +1,423 @@
+//! Running a scenario: parameters and initial conditions from the scenario, an
+//! engine, an integrator, output rows interpolated onto the output grid and
+//! written as CSV while the run goes on (a run that stops early keeps what it
+//! has written).
+
+use crate::equations::Parts;
+use crate::integrate::{self, IntegrationStats, ParkSettings, Rk4Settings};
+use crate::model_system::ModelSystem;
+use crate::system::SimError;
+use crate::Equations;
+use nalgebra::{Matrix3, Vector3};
+use railmbs_models::{IntegratorSpec, JacobianKind, Model, OutputSpec, Scenario};
+use std::io::Write;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Errors of a run that are not about the simulation itself.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{file}: {message}")]
+    Setup { file: PathBuf, message: String },
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// What a finished (or stopped) run did.
+#[derive(Debug, Clone)]
+pub struct RunSummary {
+    pub engine: String,
+    /// Simulated time reached, s.
+    pub t_end: f64,
+    pub steps: usize,
+    pub rejected_steps: usize,
+    pub newton_iterations: usize,
+    pub jacobian_evaluations: usize,
+    pub dynamics_evaluations: usize,
+    /// CPU (wall-clock, single thread) time of the integration, s.
+    pub cpu_time: f64,
+    /// Output rows written.
+    pub rows: usize,
+    /// Set when the simulation stopped with an error; rows up to that point
+    /// were written.
+    pub error: Option<SimError>,
+}
+
+impl RunSummary {
+    /// Simulated seconds per CPU second.
+    pub fn realtime_factor(&self) -> f64 {
+        self.t_end / self.cpu_time.max(1e-12)
+    }
+}
+
+/// The parameter values and initial state a scenario asks for.
+pub fn scenario_state(
+    scenario: &Scenario,
+    model: &Model,
+) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), RunError> {
+    let setup = |message: String| RunError::Setup {
+        file: scenario.source.clone(),
+        message,
+    };
+    let params = model
+        .parameter_values(&scenario.macros, &scenario.parameters)
+        .map_err(|e| setup(e.to_string()))?;
+    let (mut q, mut v) = model.initial_state(&params);
+    for o in &scenario.initial {
+        let i = model.coordinate_index(&o.coordinate).ok_or_else(|| {
+            setup(format!(
+                "initial: model \"{}\" has no coordinate \"{}\"",
+                model.name, o.coordinate
+            ))
+        })?;
+        if let Some(x) = o.value {
+            q[i] = x;
+        }
+        if let Some(x) = o.velocity {
+            v[i] = x;
+        }
+    }
+    if let Some(i) = q.iter().chain(&v).position(|x| !x.is_finite()) {
+        return Err(setup(format!(
+            "initial state of model \"{}\" is not finite (entry {i}); check the init/vel expressions",
+            model.name
+        )));
+    }
+    Ok((params, q, v))
+}
+
+/// Column layout of the output file.
+struct Columns {
+    header: Vec<String>,
+    coordinates: bool,
+    velocities: bool,
+    bodies: Vec<usize>,
+    /// (offset into all force outputs, count) of each selected element.
+    forces: Vec<(usize, usize)>,
+    need_kinematics: bool,
+}
+
+fn select(names: &[String], wanted: &[String], what: &str, file: &Path) -> Result<Vec<usize>, RunError> {
+    if wanted.iter().any(|w| w == "*") {
+        return Ok((0..names.len()).collect());
+    }
+    wanted
+        .iter()
+        .map(|w| {
+            names.iter().position(|n| n == w).ok_or_else(|| RunError::Setup {
+                file: file.to_path_buf(),
+                message: format!("output: no {what} named \"{w}\""),
+            })
+        })
+        .collect()
+}
+
+fn columns(model: &Model, system: &ModelSystem, spec: &OutputSpec, file: &Path) -> Result<Columns, RunError> {
+    let mut header = vec!["time".to_string()];
+    if spec.coordinates {
+        header.extend(model.coordinates.iter().map(|c| c.name.clone()));
+    }
+    if spec.velocities {
+        header.extend(model.coordinates.iter().map(|c| format!("{}.v", c.name)));
+    }
+    let body_names: Vec<String> = model.bodies.iter().map(|b| b.name.clone()).collect();
+    let bodies = select(&body_names, &spec.bodies, "body", file)?;
+    for &b in &bodies {
+        let n = &body_names[b];
+        for s in [
+            "x[m]", "y[m]", "z[m]", "rx[rad]", "ry[rad]", "rz[rad]", "vx[m/s]", "vy[m/s]", "vz[m/s]",
+            "wx[rad/s]", "wy[rad/s]", "wz[rad/s]",
+        ] {
+            header.push(format!("{n}.{s}"));
+        }
+    }
+    let force_names: Vec<String> = model.forces.iter().map(|f| f.name.clone()).collect();
+    let mut offsets = Vec::with_capacity(force_names.len());
+    let mut offset = 0;
+    for f in system.forces() {
+        offsets.push(offset);
+        offset += f.output_names().len();
+    }
+    let mut forces = Vec::new();
+    for e in select(&force_names, &spec.forces, "force element", file)? {
+        let names = system.forces()[e].output_names();
+        for s in &names {
+            header.push(format!("{}.{s}", force_names[e]));
+        }
+        forces.push((offsets[e], names.len()));
+    }
+    Ok(Columns {
+        header,
+        coordinates: spec.coordinates,
+        velocities: spec.velocities,
+        need_kinematics: !bodies.is_empty() || !forces.is_empty(),
+        bodies,
+        forces,
+    })
+}
+
+/// Cardan angles of a rotation matrix for the sequence x, y, z of the moving
+/// frame (A = Rx(a) Ry(b) Rz(c)), rad.
+pub fn xyz_angles(a: &Matrix3<f64>) -> Vector3<f64> {
+    let b = a[(0, 2)].clamp(-1.0, 1.0).asin();
+    let x = (-a[(1, 2)]).atan2(a[(2, 2)]);
+    let z = (-a[(0, 1)]).atan2(a[(0, 0)]);
+    Vector3::new(x, b, z)
+}
+
+/// Cubic Hermite interpolation on [t0, t1] from values and derivatives.
+fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f64) -> f64 {
+    let h = t1 - t0;
+    if h <= 0.0 {
+        return y1;
+    }
+    let s = (t - t0) / h;
+    let s2 = s * s;
+    let s3 = s2 * s;
+    (2.0 * s3 - 3.0 * s2 + 1.0) * y0
+        + (s3 - 2.0 * s2 + s) * h * d0
+        + (-2.0 * s3 + 3.0 * s2) * y1
+        + (s3 - s2) * h * d1
+}
+
+/// Integrator settings of a scenario.
+fn run_integrator(
+    system: &mut ModelSystem,
+    spec: &IntegratorSpec,
+    q0: &[f64],
+    v0: &[f64],
+    t_end: f64,
+    observer: impl FnMut(f64, &[f64], &[f64], &[f64]) -> ControlFlow<()>,
+) -> Result<IntegrationStats, SimError> {
+    match spec {
+        IntegratorSpec::Rk4 { step } => {
+            integrate::integrate_rk4(system, &Rk4Settings::new(*step), 0.0, q0, v0, t_end, observer)
+        }
+        IntegratorSpec::Park {
+            rtol,
+            atol,
+            max_step,
+            initial_step,
+            jacobian,
+        } => {
+            let mut settings = ParkSettings::with_tolerances(*rtol, *atol);
+            settings.max_step = *max_step;
+            settings.initial_step = *initial_step;
+            settings.jacobian = match jacobian {
+                JacobianKind::FiniteDifference => integrate::JacobianKind::ForwardDifference,
+                JacobianKind::Analytic => integrate::JacobianKind::Analytic,
+            };
+            integrate::integrate_park(system, &settings, 0.0, q0, v0, t_end, observer)
+        }
+    }
+}
+
+/// Output rows waiting to be written, and where they go. Rows are produced by
+/// the integrator's observer (interpolated states) and written from
+/// [`ModelSystem`]'s accept-step hook, which can evaluate kinematics and force
+/// outputs, so the file grows while the run goes on.
+pub(crate) struct Recorder {
+    columns: Columns,
+    pending: std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>,
+    writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
+    rows: usize,
+    values: Vec<f64>,
+    line: String,
+    failure: Option<RunError>,
+}
+
+impl Recorder {
+    /// Writes all pending rows. Needs the system for kinematics-based columns.
+    pub(crate) fn flush(&mut self, system: &mut ModelSystem) {
+        while let Some((t, q, v)) = self.pending.pop_front() {
+            if self.failure.is_some() {
+                continue;
+            }
+            if let Err(e) = self.write_row(system, t, &q, &v) {
+                self.failure = Some(e);
+            }
+        }
+    }
+
+    fn write_row(&mut self, system: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> Result<(), RunError> {
+        let cols = &self.columns;
+        self.values.clear();
+        self.values.push(t);
+        if cols.coordinates {
+            self.values.extend_from_slice(q);
+        }
+        if cols.velocities {
+            self.values.extend_from_slice(v);
+        }
+        if cols.need_kinematics {
+            let eval = system.evaluate(t, q, v, Parts::KINEMATICS)?;
+            for &b in &cols.bodies {
+                let k = &eval.bodies[b];
+                self.values.extend(k.position.iter());
+                self.values.extend(xyz_angles(&k.rotation).iter());
+                self.values.extend(k.velocity.iter());
+                self.values.extend(k.angular_velocity.iter());
+            }
+            let mut all = Vec::new();
+            system.force_outputs(t, &mut all);
+            for &(offset, count) in &cols.forces {
+                self.values.extend_from_slice(&all[offset..offset + count]);
+            }
+        }
+        if let Some((path, w)) = self.writer.as_mut() {
+            use std::fmt::Write as _;
+            self.line.clear();
+            for (k, x) in self.values.iter().enumerate() {
+                if k > 0 {
+                    self.line.push(',');
+                }
+                let _ = write!(self.line, "{x}");
+            }
+            writeln!(w, "{}", self.line).map_err(|source| RunError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        self.rows += 1;
+        Ok(())
+    }
+}
+
+/// Runs `scenario` on `model` with the engine `equations` and writes the output
+/// CSV to `output` (if given). `progress` is called with the simulated time
+/// now and then. A simulation error stops the run: rows up to that point are
+/// written, and the summary carries the error.
+pub fn run_scenario(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    output: Option<&Path>,
+    mut progress: impl FnMut(f64),
+) -> Result<RunSummary, RunError> {
+    let (params, q0, v0) = scenario_state(scenario, model)?;
+    let engine = equations.engine_name().to_string();
+    let mut system = ModelSystem::new(model, equations, params)?;
+    let columns = columns(model, &system, &scenario.output, &scenario.source)?;
+    let writer = match output {
+        Some(p) => {
+            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir).map_err(|source| RunError::Io {
+                    path: dir.to_path_buf(),
+                    source,
+                })?;
+            }
+            let f = std::fs::File::create(p).map_err(|source| RunError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?;
+            let mut w = std::io::BufWriter::new(f);
+            writeln!(w, "{}", columns.header.join(",")).map_err(|source| RunError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?;
+            Some((p.to_path_buf(), w))
+        }
+        None => None,
+    };
+    let recorder = std::rc::Rc::new(std::cell::RefCell::new(Recorder {
+        columns,
+        pending: Default::default(),
+        writer,
+        rows: 0,
+        values: Vec::new(),
+        line: String::new(),
+        failure: None,
+    }));
+    system.set_recorder(Some(recorder.clone()));
+
+    let t_end = scenario.end_time;
+    let interval = scenario.output.interval;
+    let n = q0.len();
+    let mut prev: Option<(f64, Vec<f64>, Vec<f64>, Vec<f64>)> = None;
+    let mut next_row = 0usize;
+    let mut last_progress = Instant::now();
+    let start = Instant::now();
+    let observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
+        let mut rec = recorder.borrow_mut();
+        if rec.failure.is_some() {
+            return ControlFlow::Break(());
+        }
+        // Output times k·interval in (t_prev, t]; the end time is always the last row.
+        loop {
+            let mut to = next_row as f64 * interval;
+            let is_last = to >= t_end * (1.0 - 1e-12);
+            if is_last {
+                to = t_end;
+            }
+            let reached = to <= t + 1e-12 * t_end.max(1.0);
+            if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
+                break;
+            }
+            let (qi, vi) = match &prev {
+                Some((t0, q0, v0, a0)) if to < t => (
+                    (0..n).map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i])).collect(),
+                    (0..n).map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i])).collect(),
+                ),
+                _ => (q.to_vec(), v.to_vec()),
+            };
+            rec.pending.push_back((to, qi, vi));
+            next_row += 1;
+            if is_last {
+                break;
+            }
+        }
+        match &mut prev {
+            Some(p) => {
+                p.0 = t;
+                p.1.copy_from_slice(q);
+                p.2.copy_from_slice(v);
+                p.3.copy_from_slice(a);
+            }
+            None => prev = Some((t, q.to_vec(), v.to_vec(), a.to_vec())),
+        }
+        if last_progress.elapsed().as_millis() > 100 {
+            progress(t);
+            last_progress = Instant::now();
+        }
+        ControlFlow::Continue(())
+    };
+    let result = run_integrator(&mut system, &scenario.integrator, &q0, &v0, t_end, observer);
+    let cpu_time = start.elapsed().as_secs_f64();
+    system.set_recorder(None);
+    let mut rec = recorder.borrow_mut();
+    rec.flush(&mut system);
+    if let Some((path, mut w)) = rec.writer.take() {
+        w.flush().map_err(|source| RunError::Io { path, source })?;
+    }
+    if let Some(e) = rec.failure.take() {
+        return Err(e);
+    }
+    let t_reached = match &result {
+        Ok(s) => s.t,
+        Err(SimError::NonFinite { t, .. }) | Err(SimError::Diverged { t, .. }) => *t,
+        Err(_) => prev.as_ref().map_or(0.0, |p| p.0),
+    };
+    let (s, error) = match result {
+        Ok(s) => (Some(s), None),
+        Err(e) => (None, Some(e)),
+    };
+    let s = s.as_ref();
+    Ok(RunSummary {
+        engine,
+        t_end: t_reached,
+        steps: s.map_or(0, |s| s.steps),
+        rejected_steps: s.map_or(0, |s| s.rejected_steps),
+        newton_iterations: s.map_or(0, |s| s.newton_iterations),
+        jacobian_evaluations: s.map_or(0, |s| s.jacobian_evaluations),
+        dynamics_evaluations: s.map_or(0, |s| s.dynamics_evaluations),
+        cpu_time,
+        rows: rec.rows,
+        error,
+    })
+}

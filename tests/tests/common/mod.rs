@@ -1,0 +1,126 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use nalgebra::{DMatrix, DVector};
+use railmbs_models::Model;
+use railmbs_runtime::integrate::{integrate_park, integrate_rk4, ParkSettings, Rk4Settings};
+use railmbs_runtime::{Equations, MechanicalSystem, ModelSystem, NumericEquations, Parts};
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+/// Path of a file under the repository's `models/` folder.
+pub fn model_path(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models").join(rel)
+}
+
+/// Loads `models/mechanisms/<name>.ron`.
+pub fn mechanism(name: &str) -> Model {
+    let p = model_path(&format!("mechanisms/{name}.ron"));
+    railmbs_models::load_model(&p).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Every bundled mechanism model.
+pub fn all_mechanisms() -> Vec<Model> {
+    let mut names: Vec<String> = std::fs::read_dir(model_path("mechanisms"))
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            (p.extension()? == "ron").then(|| p.file_stem()?.to_str().map(String::from))?
+        })
+        .collect();
+    names.sort();
+    names.iter().map(|n| mechanism(n)).collect()
+}
+
+/// A system with the numeric engine and the given parameter overrides.
+pub fn numeric_system(model: &Model, overrides: &[(&str, &str)]) -> (ModelSystem, Vec<f64>, Vec<f64>) {
+    let ov: Vec<(String, String)> = overrides
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    let params = model.parameter_values(&[], &ov).unwrap_or_else(|e| panic!("{e}"));
+    let (q0, v0) = model.initial_state(&params);
+    let sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
+    (sys, q0, v0)
+}
+
+/// Small deterministic generator (xorshift64*), uniform in [lo, hi).
+pub struct Rng(u64);
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
+        lo + (hi - lo) * x
+    }
+    pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| self.uniform(lo, hi)).collect()
+    }
+}
+
+/// Kinetic energy ½ q̇ᵀ M q̇ plus potential energy −Σ m_j g·r_j (J), at a state
+/// of a model whose only forces are gravity (and conservative springs, which
+/// are not included here).
+pub fn mechanical_energy(model: &Model, sys: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> f64 {
+    let params = sys.params().to_vec();
+    let g: Vec<f64> = model.gravity.iter().map(|e| e.eval(&params, t)).collect();
+    let masses: Vec<f64> = model.bodies.iter().map(|b| b.mass.eval(&params, t)).collect();
+    let e = sys.evaluate(t, q, v, Parts::ALL).unwrap();
+    let vv = DVector::from_column_slice(v);
+    let kinetic = 0.5 * vv.dot(&(&e.mass * &vv));
+    let potential: f64 = e
+        .bodies
+        .iter()
+        .zip(&masses)
+        .map(|(b, m)| -m * (g[0] * b.position.x + g[1] * b.position.y + g[2] * b.position.z))
+        .sum();
+    kinetic + potential
+}
+
+/// Integrates with RK4 and returns (t, q, v) of every step.
+pub fn run_rk4(sys: &mut ModelSystem, q0: &[f64], v0: &[f64], t_end: f64, h: f64) -> Vec<(f64, Vec<f64>, Vec<f64>)> {
+    let mut out = Vec::new();
+    integrate_rk4(sys, &Rk4Settings::new(h), 0.0, q0, v0, t_end, |t, q, v, _| {
+        out.push((t, q.to_vec(), v.to_vec()));
+        ControlFlow::Continue(())
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    out
+}
+
+/// Integrates with Park's method and returns (t, q, v) of every step and the stats.
+pub fn run_park(
+    sys: &mut ModelSystem,
+    settings: &ParkSettings,
+    q0: &[f64],
+    v0: &[f64],
+    t_end: f64,
+) -> (Vec<(f64, Vec<f64>, Vec<f64>)>, railmbs_runtime::integrate::IntegrationStats) {
+    let mut out = Vec::new();
+    let stats = integrate_park(sys, settings, 0.0, q0, v0, t_end, |t, q, v, _| {
+        out.push((t, q.to_vec(), v.to_vec()));
+        ControlFlow::Continue(())
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    (out, stats)
+}
+
+/// Mass matrix and f = Q − k at a state, through the `MechanicalSystem` view.
+pub fn dynamics(sys: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+    let n = sys.dof();
+    let mut m = DMatrix::zeros(n, n);
+    let mut f = DVector::zeros(n);
+    sys.dynamics(t, q, v, &mut m, &mut f).unwrap();
+    (m, f)
+}
+
+/// A fresh numeric engine for `model` with default parameters.
+pub fn numeric_engine(model: &Model) -> NumericEquations {
+    let mut e = NumericEquations::new(model);
+    e.set_parameters(&model.default_parameter_values()).unwrap();
+    e
+}
