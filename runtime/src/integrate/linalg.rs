@@ -1,0 +1,180 @@
+//! Small dense linear algebra used inside the step loop: an LU factorization
+//! with partial pivoting that works in place on a preallocated matrix, so the
+//! integrators never allocate while stepping.
+
+use nalgebra::{DMatrix, DVector};
+
+/// LU factorization `P A = L U` with partial (row) pivoting, stored in place:
+/// the strict lower triangle holds L (unit diagonal implied), the upper
+/// triangle holds U, `piv[k]` is the row swapped with row k at elimination
+/// step k.
+#[derive(Debug, Clone)]
+pub(crate) struct DenseLu {
+    lu: DMatrix<f64>,
+    piv: Vec<usize>,
+    valid: bool,
+}
+
+/// Why a factorization failed: the elimination column with a (relatively)
+/// zero or non-finite pivot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SingularPivot {
+    pub column: usize,
+}
+
+impl DenseLu {
+    /// Workspace for an `n × n` system.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            lu: DMatrix::zeros(n, n),
+            piv: vec![0; n],
+            valid: false,
+        }
+    }
+
+    /// Order of the system.
+    pub(crate) fn dim(&self) -> usize {
+        self.piv.len()
+    }
+
+    /// Resize for an `n × n` system (allocates only when n changes).
+    pub(crate) fn resize(&mut self, n: usize) {
+        if self.dim() != n {
+            *self = Self::new(n);
+        }
+        self.valid = false;
+    }
+
+    /// Whether a successful factorization is stored.
+    #[cfg(test)]
+    pub(crate) fn is_valid(&self) -> bool {
+        self.valid
+    }
+
+    /// Mark the stored factorization as unusable.
+    pub(crate) fn invalidate(&mut self) {
+        self.valid = false;
+    }
+
+    /// The matrix to be factorized; fill it, then call [`DenseLu::factorize`].
+    pub(crate) fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
+        self.valid = false;
+        &mut self.lu
+    }
+
+    /// Factorize the matrix filled through [`DenseLu::matrix_mut`] in place.
+    /// A pivot that is non-finite or below `n·ε·max|a_ij|` is reported as
+    /// singular (the matrix is then numerically rank-deficient).
+    pub(crate) fn factorize(&mut self) -> Result<(), SingularPivot> {
+        let n = self.dim();
+        self.valid = false;
+        let a = self.lu.as_mut_slice(); // column-major: a[i + j n]
+        let mut amax = 0.0_f64;
+        for &x in a.iter() {
+            if !x.is_finite() {
+                return Err(SingularPivot { column: 0 });
+            }
+            amax = amax.max(x.abs());
+        }
+        let tiny = (n.max(1) as f64) * f64::EPSILON * amax;
+        for k in 0..n {
+            let mut p = k;
+            let mut pmax = a[k + k * n].abs();
+            for i in k + 1..n {
+                let v = a[i + k * n].abs();
+                if v > pmax {
+                    pmax = v;
+                    p = i;
+                }
+            }
+            self.piv[k] = p;
+            if pmax <= tiny || !pmax.is_finite() {
+                return Err(SingularPivot { column: k });
+            }
+            if p != k {
+                for j in 0..n {
+                    a.swap(k + j * n, p + j * n);
+                }
+            }
+            let inv = 1.0 / a[k + k * n];
+            for i in k + 1..n {
+                a[i + k * n] *= inv;
+            }
+            for j in k + 1..n {
+                let akj = a[k + j * n];
+                if akj != 0.0 {
+                    // a[k+1.., j] -= l[k+1.., k] * a[k, j]; split borrows by column.
+                    let (left, right) = a.split_at_mut(j * n);
+                    let lcol = &left[k * n + k + 1..k * n + n];
+                    let col = &mut right[k + 1..n];
+                    for (c, l) in col.iter_mut().zip(lcol) {
+                        *c -= l * akj;
+                    }
+                }
+            }
+        }
+        self.valid = true;
+        Ok(())
+    }
+
+    /// Solve `A x = b` in place (b becomes x) with the stored factorization.
+    pub(crate) fn solve_in_place(&self, b: &mut DVector<f64>) {
+        debug_assert!(self.valid, "solve with an invalid LU factorization");
+        let n = self.dim();
+        let a = self.lu.as_slice();
+        let x = b.as_mut_slice();
+        for k in 0..n {
+            let p = self.piv[k];
+            if p != k {
+                x.swap(k, p);
+            }
+        }
+        // Forward substitution with unit lower triangle (column oriented).
+        for j in 0..n {
+            let xj = x[j];
+            if xj != 0.0 {
+                for i in j + 1..n {
+                    x[i] -= a[i + j * n] * xj;
+                }
+            }
+        }
+        // Back substitution with U (column oriented).
+        for j in (0..n).rev() {
+            x[j] /= a[j + j * n];
+            let xj = x[j];
+            if xj != 0.0 {
+                for i in 0..j {
+                    x[i] -= a[i + j * n] * xj;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_pivoting_system_exactly() {
+        // A needs a row swap at the first step (zero leading entry); the exact
+        // solution of A x = b with b = A·(1, 2, 3) is (1, 2, 3).
+        let a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 4.0]);
+        let x_true = DVector::from_vec(vec![1.0, 2.0, 3.0]);
+        let mut b = &a * &x_true;
+        let mut lu = DenseLu::new(3);
+        lu.matrix_mut().copy_from(&a);
+        lu.factorize().unwrap();
+        lu.solve_in_place(&mut b);
+        assert!((b - x_true).amax() < 1e-14);
+    }
+
+    #[test]
+    fn singular_matrix_is_reported() {
+        let a = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]);
+        let mut lu = DenseLu::new(2);
+        lu.matrix_mut().copy_from(&a);
+        assert_eq!(lu.factorize(), Err(SingularPivot { column: 1 }));
+        assert!(!lu.is_valid());
+    }
+}
