@@ -1,8 +1,6 @@
 //! Differentiation (memoized per variable) and substitution (memoized per substitution).
 
-use std::collections::HashMap;
-
-use crate::graph::{Context, ExprId, Func, Node, ONE, Symbol, ZERO};
+use crate::graph::{Context, ExprId, Func, FxMap, Node, ONE, Symbol, ZERO};
 
 const UNKNOWN: u32 = u32::MAX;
 const PENDING: u32 = u32::MAX - 1;
@@ -192,8 +190,8 @@ impl Context {
 /// calls on the same [`Context`].
 #[derive(Clone, Debug, Default)]
 pub struct Substitution {
-    map: HashMap<crate::graph::Symbol, ExprId>,
-    memo: HashMap<ExprId, ExprId>,
+    map: FxMap<Symbol, ExprId>,
+    memo: FxMap<ExprId, ExprId>,
 }
 
 impl Substitution {
@@ -201,7 +199,7 @@ impl Substitution {
     pub fn new(pairs: &[(Symbol, ExprId)]) -> Self {
         Substitution {
             map: pairs.iter().copied().collect(),
-            memo: HashMap::new(),
+            memo: FxMap::default(),
         }
     }
 
@@ -213,7 +211,7 @@ impl Substitution {
         // Unvisited part of the DAG below e, in ascending (topological) order.
         let mut order = Vec::new();
         let mut stack = vec![e];
-        let mut seen = std::collections::HashSet::new();
+        let mut seen: std::collections::HashSet<ExprId, crate::graph::FxBuild> = Default::default();
         seen.insert(e);
         while let Some(id) = stack.pop() {
             order.push(id);

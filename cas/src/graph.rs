@@ -273,6 +273,52 @@ fn hash_node(n: &Node) -> u64 {
     h.finish()
 }
 
+/// `BuildHasher` for the crate's internal maps (keys are small integers; SipHash's
+/// DoS-resistance is not needed and costs a large share of CSE time).
+#[derive(Clone, Copy, Default)]
+pub(crate) struct FxBuild;
+
+pub(crate) struct FxHasher(Fx);
+
+impl std::hash::Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut b = [0u8; 8];
+            b[..chunk.len()].copy_from_slice(chunk);
+            self.0.add(u64::from_le_bytes(b));
+        }
+    }
+    fn write_u8(&mut self, i: u8) {
+        self.0.add(i as u64)
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.0.add(i as u64)
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0.add(i)
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.0.add(i as u64)
+    }
+    fn write_isize(&mut self, i: isize) {
+        self.0.add(i as u64)
+    }
+    fn finish(&self) -> u64 {
+        // hashbrown indexes with the low bits: move the well-mixed high bits down.
+        self.0.0.rotate_left(26)
+    }
+}
+
+impl std::hash::BuildHasher for FxBuild {
+    type Hasher = FxHasher;
+    fn build_hasher(&self) -> FxHasher {
+        FxHasher(Fx(0))
+    }
+}
+
+/// Hash map with [`FxBuild`].
+pub(crate) type FxMap<K, V> = std::collections::HashMap<K, V, FxBuild>;
+
 const EMPTY: u32 = u32::MAX;
 
 /// Normalizes a number for storage: `-0.0` becomes `0.0`.
@@ -287,7 +333,7 @@ pub struct Context {
     hashes: Vec<u64>,
     table: Vec<u32>,
     /// Per differentiation variable: derivative of node `i` at index `i` (`EMPTY` = unknown).
-    pub(crate) diff_cache: std::collections::HashMap<Symbol, Vec<u32>>,
+    pub(crate) diff_cache: FxMap<Symbol, Vec<u32>>,
 }
 
 impl Default for Context {
@@ -885,7 +931,7 @@ impl Context {
     /// expressions only (e.g. to compare forms in tests). Negative powers of sums are kept.
     pub fn expand(&mut self, x: ExprId) -> ExprId {
         let order = self.reachable(&[x]);
-        let mut map: std::collections::HashMap<ExprId, ExprId> = Default::default();
+        let mut map: FxMap<ExprId, ExprId> = Default::default();
         for id in order {
             let node = self.node(id).clone();
             let r = match node {
@@ -954,18 +1000,25 @@ impl Context {
     /// All nodes reachable from `roots`, in ascending id (= topological) order. Iterative, so
     /// deep expressions cannot overflow the stack.
     pub fn reachable(&self, roots: &[ExprId]) -> Vec<ExprId> {
-        let mut seen = std::collections::HashSet::new();
+        // Visited set as a bitset over the arena: one bit per node.
+        let mut seen = vec![0u64; self.nodes.len().div_ceil(64)];
+        let mut visit = |id: ExprId| {
+            let (w, b) = (id.index() / 64, id.index() % 64);
+            let new = seen[w] & (1 << b) == 0;
+            seen[w] |= 1 << b;
+            new
+        };
         let mut stack: Vec<ExprId> = Vec::new();
         let mut out = Vec::new();
         for &r in roots {
-            if seen.insert(r) {
+            if visit(r) {
                 stack.push(r);
             }
         }
         while let Some(id) = stack.pop() {
             out.push(id);
             self.node(id).for_each_child(|c| {
-                if seen.insert(c) {
+                if visit(c) {
                     stack.push(c);
                 }
             });

@@ -1,12 +1,11 @@
 //! Common-subexpression elimination into straight-line code, operation counts, and splitting
 //! of the code into chunks of bounded size.
 
-use std::collections::HashMap;
 use std::fmt;
 use std::ops::Range;
 
 use crate::eval::{CasError, Values};
-use crate::graph::{Context, ExprId, Func, Node, Symbol};
+use crate::graph::{Context, ExprId, Func, FxMap, Node, Symbol};
 
 /// An instruction operand: a temporary (the result of instruction `k`), a symbol (an input), or
 /// a constant.
@@ -169,8 +168,8 @@ enum InstrKey {
 struct Builder {
     instrs: Vec<Instr>,
     share: bool,
-    vn: HashMap<InstrKey, u32>,
-    pows: HashMap<(ExprId, u32), Operand>,
+    vn: FxMap<InstrKey, u32>,
+    pows: FxMap<(ExprId, u32), Operand>,
 }
 
 impl Builder {
@@ -178,8 +177,8 @@ impl Builder {
         Builder {
             instrs: Vec::new(),
             share,
-            vn: HashMap::new(),
-            pows: HashMap::new(),
+            vn: FxMap::default(),
+            pows: FxMap::default(),
         }
     }
 
@@ -344,14 +343,14 @@ impl Program {
     pub fn compile(ctx: &Context, outputs: &[ExprId]) -> Program {
         let order = ctx.reachable(outputs);
         let mut b = Builder::new(true);
-        let mut ops: HashMap<ExprId, Operand> = HashMap::with_capacity(order.len());
+        let size = order.last().map_or(0, |l| l.index() + 1);
+        let mut ops: Vec<Operand> = vec![Operand::Const(0.0); size];
         for id in order {
-            let o = b.lower(ctx.node(id), |c| ops[&c]);
-            ops.insert(id, o);
+            ops[id.index()] = b.lower(ctx.node(id), |c| ops[c.index()]);
         }
         Program {
             instrs: b.instrs,
-            outputs: outputs.iter().map(|o| ops[o]).collect(),
+            outputs: outputs.iter().map(|o| ops[o.index()]).collect(),
         }
     }
 
@@ -384,7 +383,7 @@ impl Program {
 
     /// Pairs `(k_sin, k_cos)` of instructions computing sin and cos of the same operand.
     pub fn sin_cos_pairs(&self) -> Vec<(u32, u32)> {
-        let mut sins: HashMap<OpKey, u32> = HashMap::new();
+        let mut sins: FxMap<OpKey, u32> = FxMap::default();
         for (k, i) in self.instrs.iter().enumerate() {
             if let Instr::Call(Func::Sin, a) = i {
                 sins.insert(key(*a), k as u32);
@@ -636,7 +635,8 @@ impl Context {
     /// subexpression is counted again), lowered like [`Program::compile`] does.
     pub fn tree_op_counts(&self, roots: &[ExprId]) -> OpCounts {
         let order = self.reachable(roots);
-        let mut tree: HashMap<ExprId, OpCounts> = HashMap::with_capacity(order.len());
+        let size = order.last().map_or(0, |l| l.index() + 1);
+        let mut tree: Vec<OpCounts> = vec![OpCounts::default(); size];
         let mut b = Builder::new(false);
         for id in order {
             let node = self.node(id);
@@ -646,11 +646,11 @@ impl Context {
                 .instrs
                 .iter()
                 .fold(OpCounts::default(), |acc, i| acc.plus(i.counts()));
-            node.for_each_child(|ch| c = c.plus(tree[&ch]));
-            tree.insert(id, c);
+            node.for_each_child(|ch| c = c.plus(tree[ch.index()]));
+            tree[id.index()] = c;
         }
         roots
             .iter()
-            .fold(OpCounts::default(), |acc, r| acc.plus(tree[r]))
+            .fold(OpCounts::default(), |acc, r| acc.plus(tree[r.index()]))
     }
 }
