@@ -36,6 +36,7 @@ pub struct KalkerCoefficients {
 /// Table rows: columns C11(ν=0, 0.25, 0.5), C22(…), C23(…), C33(…). Rows 0–9:
 /// a/b = 0.1 … 1.0; rows 10–18: b/a = 0.9 … 0.1. Kalker 1990, Table E.3.
 #[rustfmt::skip]
+#[allow(clippy::approx_constant)] // 3.14 is a table value, not π
 const TABLE: [[f64; 12]; 19] = [
     [2.51, 3.31, 4.85, 2.51, 2.52, 2.53, 0.334, 0.473, 0.731, 6.42, 8.28, 11.7], // a/b = 0.1
     [2.59, 3.37, 4.81, 2.59, 2.63, 2.66, 0.483, 0.603, 0.809, 3.46, 4.27, 5.66], // a/b = 0.2

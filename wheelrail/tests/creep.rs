@@ -1,0 +1,405 @@
+//! Creep-force laws against published references: Kalker's linear theory
+//! (Kalker 1990, Table E.3), CONTACT's FASTSIM example and traction curves
+//! (E.A.H. Vollebregt, CONTACT, `../shared/reference/contact`), and the
+//! saturation limit μN (Coulomb).
+
+use railmbs_wheelrail::creep::{
+    ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, FastsimLayout,
+    KalkerLinear, Mueller, TractionBound,
+};
+
+const REF: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../shared/reference/contact/"
+);
+
+/// Rows of a CONTACT result CSV as (header → value) lookups.
+fn contact_rows(file: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut rd = csv::Reader::from_path(format!("{REF}{file}")).expect("reference CSV");
+    let hdr = rd.headers().unwrap().clone();
+    rd.records()
+        .map(|r| {
+            let r = r.unwrap();
+            hdr.iter()
+                .map(str::to_string)
+                .zip(r.iter().map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
+    row[key].parse().unwrap()
+}
+
+fn tread_patch() -> ContactPatch {
+    // A typical tread contact: a = 6 mm, b = 4 mm, steel G = 80 GPa, ν = 0.28.
+    ContactPatch {
+        a: 6e-3,
+        b: 4e-3,
+        g: 80e9,
+        nu: 0.28,
+        mu: 0.3,
+        n: 80e3,
+    }
+}
+
+/// At small creepage FASTSIM and FastSim_A reproduce Kalker's linear theory: the
+/// flexibilities L1, L2, L3 are defined so that the continuous simplified theory
+/// gives exactly G c² C11 ξ, G c² C22 η and G c³ C23 φ; what remains is the strip
+/// quadrature in y (midpoint rule over √(1 − y²/b²)-shaped strips: 0.4 % for 10
+/// strips) — tolerance 2 %.
+#[test]
+fn linear_limit_matches_kalker() {
+    let p = tread_patch();
+    let eps = 1e-7;
+    let laws: Vec<Box<dyn CreepLaw>> = vec![
+        Box::new(Fastsim::new(10, 10).unwrap()),
+        Box::new(Fastsim::new(25, 20).unwrap()),
+        Box::new(FastsimA::new(10).unwrap()),
+        Box::new(FastsimA::new(25).unwrap()),
+    ];
+    for law in &laws {
+        for (c, pick) in [
+            (
+                Creepages {
+                    xi: eps,
+                    eta: 0.0,
+                    phi: 0.0,
+                },
+                0,
+            ),
+            (
+                Creepages {
+                    xi: 0.0,
+                    eta: eps,
+                    phi: 0.0,
+                },
+                1,
+            ),
+            (
+                Creepages {
+                    xi: 0.0,
+                    eta: 0.0,
+                    phi: eps / 4e-3,
+                },
+                1,
+            ),
+        ] {
+            let lin = KalkerLinear.forces(&p, &c).unwrap();
+            let f = law.forces(&p, &c).unwrap();
+            let (x, r) = if pick == 0 {
+                (f.fx, lin.fx)
+            } else {
+                (f.fy, lin.fy)
+            };
+            assert!(
+                (x / r - 1.0).abs() < 0.02,
+                "{}: {c:?}: {x} vs linear {r}",
+                law.name()
+            );
+        }
+    }
+}
+
+/// At large creepage the whole contact slides and the force is μN (Coulomb);
+/// FASTSIM and FastSim_A normalise the bound so this holds to rounding, Mueller
+/// approaches it as 1 − O(u⁻³).
+#[test]
+fn large_creepage_saturates_at_mu_n() {
+    let p = tread_patch();
+    let mu_n = p.mu * p.n;
+    let laws: Vec<Box<dyn CreepLaw>> = vec![
+        Box::new(Fastsim::new(10, 10).unwrap()),
+        Box::new(
+            Fastsim::new(10, 10)
+                .unwrap()
+                .with_bound(TractionBound::Elliptic),
+        ),
+        Box::new(FastsimA::new(10).unwrap()),
+        Box::new(Mueller::default()),
+    ];
+    for law in &laws {
+        for c in [
+            Creepages {
+                xi: 0.2,
+                eta: 0.0,
+                phi: 0.0,
+            },
+            Creepages {
+                xi: -0.1,
+                eta: 0.1,
+                phi: 0.0,
+            },
+            Creepages {
+                xi: 0.0,
+                eta: -0.3,
+                phi: 0.0,
+            },
+        ] {
+            let f = law.forces(&p, &c).unwrap();
+            let t = f.fx.hypot(f.fy);
+            assert!(t <= mu_n * (1.0 + 1e-9), "{}: {t}", law.name());
+            assert!(t > 0.99 * mu_n, "{}: {c:?}: {t} vs μN {mu_n}", law.name());
+            // Direction opposes the creepage (forces on the wheel).
+            assert!(f.fx * c.xi <= 0.0 && f.fy * c.eta <= 0.0);
+        }
+    }
+}
+
+fn contact_patch_mm(row: &std::collections::HashMap<String, String>) -> (ContactPatch, Creepages) {
+    // CONTACT units: mm, N, N/mm², spin rad/mm → SI.
+    (
+        ContactPatch {
+            a: num(row, "AA") * 1e-3,
+            b: num(row, "BB") * 1e-3,
+            g: num(row, "G") * 1e6,
+            nu: num(row, "NU"),
+            mu: num(row, "FSTAT"),
+            n: num(row, "FN"),
+        },
+        Creepages {
+            xi: num(row, "CKSI"),
+            eta: num(row, "CETA"),
+            phi: num(row, "CPHI") * 1e3,
+        },
+    )
+}
+
+/// CONTACT's FASTSIM example (a = 8, b = 4 mm, η = −0.000625, φ = 0.000625/mm):
+/// our FASTSIM on CONTACT's grid (MX = MY = 44 and 220 over 1.1× the ellipse)
+/// against CONTACT's FASTSIM with the parabolic and the elliptic bound.
+///
+/// Tolerances: on the 220 grid 1 % of Fy and Mz; on the 44 grid 3 %. CONTACT's
+/// grid FASTSIM places the rigid slip and the first cell of each row in a way
+/// the reference files do not document; on 40 cells per row, moving the point
+/// where the spin slip is evaluated by half a cell changes Fy by up to 10 %
+/// (measured while developing), on 200 cells five times less. The converged
+/// FASTSIM is also compared with CONTACT's exact (half-space) result −0.6074
+/// loosely (FASTSIM is known to differ from the exact theory by up to
+/// ~10–15 % under spin): within 10 %.
+#[test]
+fn contact_fastsim_example() {
+    let rows = contact_rows("contact_fastsim_example.csv");
+    let mut checked = 0;
+    for row in &rows {
+        let (m, b, mx) = (num(row, "M"), num(row, "B"), num(row, "MX"));
+        if m != 3.0 || num(row, "CHI") != 0.0 {
+            continue;
+        }
+        let bound = if b == 3.0 {
+            TractionBound::Parabolic
+        } else {
+            TractionBound::Elliptic
+        };
+        let (p, c) = contact_patch_mm(row);
+        let law = Fastsim::new(mx as usize, mx as usize)
+            .unwrap()
+            .with_bound(bound)
+            .with_layout(FastsimLayout::UniformGrid { scale: 1.1 })
+            .unwrap();
+        let f = law.forces(&p, &c).unwrap();
+        let fy = f.fy / (p.mu * p.n);
+        let fy_ref = num(row, "FY_over_muFN");
+        let mz_ref = num(row, "MZ") * 1e-3; // N·mm → N·m
+        let tol = if mx > 100.0 { 0.01 } else { 0.03 };
+        assert!(
+            (fy / fy_ref - 1.0).abs() < tol,
+            "{mx} {b}: Fy/μN {fy} vs CONTACT {fy_ref}"
+        );
+        assert!(
+            (f.mz / mz_ref - 1.0).abs() < tol,
+            "{mx} {b}: Mz {} vs {mz_ref}",
+            f.mz
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 4);
+    // Exact theory, case 1.
+    let (p, c) = contact_patch_mm(&rows[0]);
+    let exact = num(&rows[0], "FY_over_muFN");
+    assert_eq!(exact, -0.6074);
+    let f = Fastsim::new(100, 100).unwrap().forces(&p, &c).unwrap();
+    let fy = f.fy / (p.mu * p.n);
+    assert!(
+        (fy / exact - 1.0).abs() < 0.10,
+        "FASTSIM {fy} vs exact {exact}"
+    );
+}
+
+/// CONTACT's traction curve (a/b = 0.5, Fn = 106.7 kN, μ = 0.33, pure ξ):
+/// - our grid FASTSIM (CONTACT's 48 × 44 grid) against CONTACT's FASTSIM
+///   (cases 61–90): within 0.015 μFn everywhere — the curves differ by a constant
+///   0.9 % in slope at small creepage (CONTACT's C11 for ν = 0.28 is 0.9 % below
+///   our linear interpolation in ν of Kalker's table) and agree to 0.1 % at
+///   saturation;
+/// - our FASTSIM (strips, 20 × 40) and FastSim_A (20 strips, exact for zero
+///   spin) against CONTACT's exact solution (cases 1–30): FASTSIM's parabolic
+///   bound makes it saturate earlier than the exact theory; the largest
+///   difference, in the transition, is measured at 0.05 μFn — tolerance 0.07 μFn
+///   (about 10 % of the force there), as known for FASTSIM.
+#[test]
+fn contact_traction_curves() {
+    let rows = contact_rows("contact_tractcurv_example.csv");
+    let grid = Fastsim::new(44, 48)
+        .unwrap()
+        .with_layout(FastsimLayout::UniformGrid { scale: 1.1 })
+        .unwrap();
+    let strips = Fastsim::new(20, 40).unwrap();
+    let fsa = FastsimA::new(20).unwrap();
+    let (mut n_fast, mut n_exact) = (0, 0);
+    let mut worst_exact = 0.0_f64;
+    for (i, row) in rows.iter().enumerate() {
+        let case = i + 1;
+        let (p, c) = contact_patch_mm(row);
+        let fx_ref = num(row, "FX_over_muFN");
+        let mu_n = p.mu * p.n;
+        if (61..=90).contains(&case) {
+            let f = grid.forces(&p, &c).unwrap();
+            assert!(
+                (f.fx / mu_n - fx_ref).abs() < 0.015,
+                "case {case}: {} vs {fx_ref}",
+                f.fx / mu_n
+            );
+            n_fast += 1;
+        } else if case <= 30 {
+            for f in [strips.forces(&p, &c).unwrap(), fsa.forces(&p, &c).unwrap()] {
+                let d = (f.fx / mu_n - fx_ref).abs();
+                worst_exact = worst_exact.max(d);
+                assert!(d < 0.07, "case {case}: {} vs exact {fx_ref}", f.fx / mu_n);
+            }
+            n_exact += 1;
+        }
+    }
+    assert_eq!((n_fast, n_exact), (30, 30));
+    eprintln!("largest |FASTSIM − exact| = {worst_exact:.4} μFn");
+}
+
+fn rel_total(a: &CreepForces, r: &CreepForces) -> f64 {
+    (a.fx - r.fx).hypot(a.fy - r.fy) / r.fx.hypot(r.fy)
+}
+
+/// FastSim_A against FASTSIM with many elements (same 20 strips, 4000 elements
+/// per strip: FASTSIM's own discretisation error is then < 0.1 %):
+/// - zero spin: FastSim_A is the exact strip solution (paper property 1):
+///   agreement to 0.2 %;
+/// - tread-contact spin (|φ| ≤ 0.3 1/m, i.e. |φ|a ≤ 0.0018 for a = 6 mm; contact
+///   angles up to ~8° on a 0.46 m wheel): within 5 % of the total force;
+/// - flange-contact spin (φ = 1.5 1/m): the error is large (measured ~20–70 %)
+///   and is only bounded here to document it.
+#[test]
+fn fastsim_a_against_fine_fastsim() {
+    let p = tread_patch();
+    let fine = Fastsim::new(20, 4000).unwrap();
+    let fsa = FastsimA::new(20).unwrap();
+    let mut worst_tread = 0.0_f64;
+    for xi in [0.0, 3e-4, 1e-3, 3e-3, 1e-2] {
+        for eta in [0.0, -5e-4, 1e-3, 3e-3] {
+            if xi == 0.0 && eta == 0.0 {
+                continue;
+            }
+            let c = Creepages { xi, eta, phi: 0.0 };
+            let e = rel_total(&fsa.forces(&p, &c).unwrap(), &fine.forces(&p, &c).unwrap());
+            assert!(e < 2e-3, "zero spin ξ {xi} η {eta}: {e}");
+            for phi in [0.1, -0.1, 0.3, -0.3] {
+                let c = Creepages { xi, eta, phi };
+                let e = rel_total(&fsa.forces(&p, &c).unwrap(), &fine.forces(&p, &c).unwrap());
+                worst_tread = worst_tread.max(e);
+                assert!(e < 0.05, "ξ {xi} η {eta} φ {phi}: {e}");
+            }
+        }
+    }
+    let c = Creepages {
+        xi: 1e-3,
+        eta: 0.0,
+        phi: 1.5,
+    };
+    let e = rel_total(&fsa.forces(&p, &c).unwrap(), &fine.forces(&p, &c).unwrap());
+    eprintln!("FastSim_A vs FASTSIM: worst tread {worst_tread:.4}, flange spin φ = 1.5/m: {e:.3}");
+    assert!(e < 1.0);
+}
+
+/// Mueller: linear at small creepage, μN at large, monotone in between.
+#[test]
+fn mueller_saturation() {
+    let p = tread_patch();
+    let m = Mueller::default();
+    let c = Creepages {
+        xi: 1e-7,
+        eta: 0.0,
+        phi: 0.0,
+    };
+    let lin = KalkerLinear.forces(&p, &c).unwrap();
+    assert!((m.forces(&p, &c).unwrap().fx / lin.fx - 1.0).abs() < 1e-9);
+    let mut last = 0.0;
+    for k in 1..60 {
+        let xi = 1e-5 * 1.2_f64.powi(k);
+        let f = m
+            .forces(
+                &p,
+                &Creepages {
+                    xi,
+                    eta: 0.0,
+                    phi: 0.0,
+                },
+            )
+            .unwrap();
+        assert!(-f.fx > last && -f.fx < p.mu * p.n);
+        last = -f.fx;
+    }
+    assert!(Mueller::new(0.0).is_err());
+}
+
+/// Bad input is an error naming the input, never a panic or NaN.
+#[test]
+fn bad_input_is_named() {
+    let p = tread_patch();
+    let c = Creepages {
+        xi: 1e-3,
+        eta: 0.0,
+        phi: 0.0,
+    };
+    let laws: Vec<Box<dyn CreepLaw>> = vec![
+        Box::new(KalkerLinear),
+        Box::new(Mueller::default()),
+        Box::new(Fastsim::new(5, 5).unwrap()),
+        Box::new(FastsimA::new(5).unwrap()),
+    ];
+    for law in &laws {
+        for (q, cc, name) in [
+            (ContactPatch { a: -1.0, ..p }, c, "a"),
+            (ContactPatch { b: f64::NAN, ..p }, c, "b"),
+            (ContactPatch { g: 0.0, ..p }, c, "G"),
+            (ContactPatch { nu: 0.7, ..p }, c, "nu"),
+            (ContactPatch { mu: -0.1, ..p }, c, "mu"),
+            (
+                ContactPatch {
+                    n: f64::INFINITY,
+                    ..p
+                },
+                c,
+                "N",
+            ),
+            (p, Creepages { xi: f64::NAN, ..c }, "xi"),
+            (
+                p,
+                Creepages {
+                    eta: f64::INFINITY,
+                    ..c
+                },
+                "eta",
+            ),
+            (p, Creepages { phi: f64::NAN, ..c }, "phi"),
+        ] {
+            match law.forces(&q, &cc) {
+                Err(CreepError::Input { name: n, .. }) => assert_eq!(n, name),
+                other => panic!("{}: expected error for {name}, got {other:?}", law.name()),
+            }
+        }
+        // Zero load: zero force, no NaN.
+        let f = law.forces(&ContactPatch { n: 0.0, ..p }, &c).unwrap();
+        assert_eq!(f, CreepForces::default());
+    }
+    assert!(Fastsim::new(0, 10).is_err());
+    assert!(FastsimA::new(0).is_err());
+}
