@@ -56,7 +56,8 @@ impl RunSummary {
     }
 }
 
-/// The parameter values and initial state a scenario asks for.
+/// The parameter values and initial state a scenario asks for (errors name the
+/// scenario file, with line and column).
 pub fn scenario_state(
     scenario: &Scenario,
     model: &Model,
@@ -65,24 +66,12 @@ pub fn scenario_state(
         file: scenario.source.clone(),
         message,
     };
-    let params = model
-        .parameter_values(&scenario.macros, &scenario.parameters)
+    let params = scenario
+        .parameter_values(model)
         .map_err(|e| setup(e.to_string()))?;
-    let (mut q, mut v) = model.initial_state(&params);
-    for o in &scenario.initial {
-        let i = model.coordinate_index(&o.coordinate).ok_or_else(|| {
-            setup(format!(
-                "initial: model \"{}\" has no coordinate \"{}\"",
-                model.name, o.coordinate
-            ))
-        })?;
-        if let Some(x) = o.value {
-            q[i] = x;
-        }
-        if let Some(x) = o.velocity {
-            v[i] = x;
-        }
-    }
+    let (q, v) = scenario
+        .initial_state(model, &params)
+        .map_err(|e| setup(e.to_string()))?;
     if let Some(i) = q.iter().chain(&v).position(|x| !x.is_finite()) {
         return Err(setup(format!(
             "initial state of model \"{}\" is not finite (entry {i}); check the init/vel expressions",
