@@ -436,7 +436,8 @@ impl Program {
         }
         self.outputs
             .iter()
-            .map(|&o| operand_value(o, &tmp, values))
+            .enumerate()
+            .map(|(i, &o)| operand_value(o, &tmp, values).and_then(|x| check_output(i, x)))
             .collect()
     }
 
@@ -518,6 +519,18 @@ impl Program {
             chunks,
             n_slots: n_slots as usize,
             slot_of_tmp,
+        })
+    }
+}
+
+/// Outputs that are inputs or constants bypass the instruction checks: check them here.
+fn check_output(i: usize, x: f64) -> Result<f64, CasError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(CasError::NonFinite {
+            value: x,
+            location: format!("output {i}"),
         })
     }
 }
@@ -626,6 +639,8 @@ impl SplitProgram {
                 Operand::Sym(s) => values.get(s),
                 Operand::Const(c) => Ok(c),
             })
+            .enumerate()
+            .map(|(i, r)| r.and_then(|x| check_output(i, x)))
             .collect()
     }
 }

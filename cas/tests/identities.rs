@@ -424,6 +424,21 @@ fn evaluation_errors_are_reported() {
     let l = c.ln(m1);
     assert!(c.eval(&[l], &Values::default()).is_err());
     assert!(prog.split(0).is_err());
+    // a NaN input passed straight to an output is reported too
+    let p = Program::compile(&c, &[x]);
+    let nan = Values {
+        q: &[f64::NAN],
+        ..Default::default()
+    };
+    assert!(matches!(p.eval(&nan), Err(CasError::NonFinite { .. })));
+    assert!(matches!(
+        p.split(4).unwrap().eval(&p, &nan),
+        Err(CasError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        c.eval(&[x], &nan),
+        Err(CasError::NonFinite { .. })
+    ));
 }
 
 #[test]
