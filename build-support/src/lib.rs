@@ -47,7 +47,43 @@
 //!
 //! # Compile time versus run time
 //!
-//! MEASUREMENTS_PLACEHOLDER
+//! Measured with `examples/compile_time.rs` (rustc 1.95.0, LLVM 22, x86_64 Linux, a 2-core
+//! machine shared with other builds, load average 5–10, so wall times are noisy; CPU time is
+//! user + system of rustc and the linker). Source: 20 000 lines of straight-line f64
+//! arithmetic like CSE'd equations of motion (`let tN: f64 = (a * b + c) * 0.5;`, every
+//! twelfth line a sin or cos), split into 40 functions of 500 lines, or the same statements
+//! in one function. `eval` is one call of the whole thing, best of 60 batches; all builds
+//! give bit-identical results.
+//!
+//! ```text
+//! cargo run --release -p railmbs-build-support --example compile_time
+//! ```
+//!
+//! | layout         | opt-level | codegen-units | compile CPU (s) | compile wall (s) | eval (µs) |
+//! |----------------|-----------|---------------|-----------------|------------------|-----------|
+//! | 40 × 500 lines | 1         | 1 / 2 / 16    | 4.0 / 4.0 / 3.9 | 12.1 / 10.7 / 10.5 | 21.6 / 21.0 / 21.0 |
+//! | 40 × 500 lines | 2         | 1 / 2 / 16    | 4.0 / 4.0 / 3.9 | 11.6 / 10.4 / 10.1 | 20.9 / 21.7 / 21.5 |
+//! | 40 × 500 lines | 3         | 1 / 2 / 16    | 4.5 / 4.5 / 4.7 | 9.6 / 10.9 / 11.6  | 22.3 / 22.4 / 21.6 |
+//! | 1 × 20 000     | 1         | 1 / 2 / 16    | 9.3 / 8.9 / 10.4 | 13.1 / 10.4 / 14.8 | 21.1 / 20.8 / 21.0 |
+//! | 1 × 20 000     | 2         | 1 / 2 / 16    | 10.5 / 12.1 / 12.1 | 16.3 / 29.9 / 32.9 | 21.3 / 21.2 / 21.4 |
+//! | 1 × 20 000     | 3         | 1 / 2 / 16    | 19.7 / 12.3 / 13.4 | 36.1 / 15.6 / 22.0 | 21.6 / 20.5 / 21.8 |
+//!
+//! Findings:
+//! - **Split the code.** Functions of ≤ 1000 lines compile 2.3–4.4× faster in CPU time than
+//!   one huge function (LLVM is superlinear in function size), at the same run time. CPU
+//!   seconds by function size (20 000 lines, opt-level 2, codegen-units 1, one run each,
+//!   `--chunk N --layout split --opt 2 --cgu 1`): 100 lines 3.8, 250 → 3.8, 500 → 3.6,
+//!   1000 → 4.0, 2000 → 4.4, 5000 → 6.0.
+//! - **The front end dominates** a split build: `--emit=metadata` (parse, type and borrow
+//!   check) alone takes 2.2 s CPU of the 3.6 s; the whole build at opt-level 0 takes 2.6 s.
+//! - **opt-level** 1, 2 and 3 run this straight-line scalar code equally fast (±5 %, the
+//!   noise); 3 costs ~12 % more compile time. 2 is the default, as DESIGN.md prescribes.
+//! - **codegen-units** does not change CPU time or run time for split code; in paired runs
+//!   (same source, alternating, three times) 16 units cut wall time from 6.9 / 7.1 / 4.3 s to
+//!   5.2 / 6.4 / 3.2 s because LLVM's share runs on both cores. Hence the default
+//!   [`DEFAULT_CODEGEN_UNITS`] = 16 (rustc's own default for non-incremental builds).
+//! - Output size ~1 MiB with `strip=debuginfo` (std's debug info would add ~4 MiB).
+//! - Output is deterministic: two builds of one key are byte-identical (checked with `cmp`).
 
 mod cache;
 mod error;
@@ -215,6 +251,8 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
     options.validate()?;
     let rustc = find_rustc(options.rustc.as_deref())?;
     let cache = resolve_cache_dir(options.cache_dir.as_deref())?;
+    // Absolute, so that paths in errors and diagnostics are unambiguous.
+    let cache = std::path::absolute(&cache).map_err(|e| BuildError::io(&cache, e))?;
     let flags = options.flags();
     let hash = cache_key(source, &rustc.version, &flags, options.abi_version);
     let crate_name = format!("railmbs_plugin_{hash}");
@@ -260,9 +298,9 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
         remap.push(&failed_dir);
         cmd.arg("--remap-path-prefix").arg(remap);
     }
-    cmd.arg(&src_path)
-        .current_dir(tmp.path())
-        .stdin(Stdio::null());
+    // Same working directory as `rustc -vV` in `find_rustc`: a rustup proxy picks the
+    // toolchain by directory, and the key must name the toolchain that compiles.
+    cmd.arg(&src_path).stdin(Stdio::null());
 
     let start = Instant::now();
     let out = cmd.output().map_err(|e| BuildError::RustcNotFound {
