@@ -319,6 +319,17 @@ proptest! {
     }
 
     #[test]
+    fn commuted_operands_give_the_same_node(t in tree()) {
+        // canonical operand order: a + b and b + a, a·b and b·a are one node, at every level
+        let mut c = Context::new();
+        let a = build(&mut c, &t);
+        let n = c.len();
+        let b = build(&mut c, &mirror(&t));
+        prop_assert_eq!(a, b);
+        prop_assert_eq!(c.len(), n, "the mirrored tree created new nodes");
+    }
+
+    #[test]
     fn program_evaluates_equal_to_dag(ts in prop::collection::vec(tree(), 1..5), s in point()) {
         let mut c = Context::new();
         let es: Vec<ExprId> = ts.iter().map(|t| build(&mut c, t)).collect();
@@ -379,6 +390,31 @@ proptest! {
         let got = c.eval(&[out], &values(&s)).unwrap()[0];
         // r(s) itself carries a rounding error that propagates through t; allow 1e-9 · M
         prop_assert!((got - want).abs() <= 1e-9 * (1.0 + mag), "{got} vs {want}");
+    }
+}
+
+/// The same tree with the operands of every commutative operation swapped.
+fn mirror(t: &T) -> T {
+    let m = |x: &T| Box::new(mirror(x));
+    match t {
+        T::Num(_) | T::Sym(_) => t.clone(),
+        T::Add(a, b) => T::Add(m(b), m(a)),
+        T::Mul(a, b) => T::Mul(m(b), m(a)),
+        T::Sub(a, b) => T::Sub(m(a), m(b)),
+        T::Neg(a) => T::Neg(m(a)),
+        T::Scale(c, a) => T::Scale(*c, m(a)),
+        T::DivSafe(a, b) => T::DivSafe(m(a), m(b)),
+        T::Pow(a, n) => T::Pow(m(a), *n),
+        T::PowNegSafe(a, n) => T::PowNegSafe(m(a), *n),
+        T::Sin(a) => T::Sin(m(a)),
+        T::Cos(a) => T::Cos(m(a)),
+        T::TanSin(a) => T::TanSin(m(a)),
+        T::SqrtSafe(a) => T::SqrtSafe(m(a)),
+        T::ExpSin(a) => T::ExpSin(m(a)),
+        T::LnSafe(a) => T::LnSafe(m(a)),
+        T::Abs(a) => T::Abs(m(a)),
+        T::Atan2Safe(a, b) => T::Atan2Safe(m(a), m(b)),
+        T::Pyth(a, b) => T::Pyth(m(a), m(b)),
     }
 }
 
