@@ -23,7 +23,7 @@ pub enum BuildError {
          rustc's stderr (also in {}):\n{}",
         source_path.display(),
         stderr_path.display(),
-        truncate(stderr)
+        truncate(stderr.trim_end())
     )]
     CompileFailed {
         /// The generated source, kept in the cache's `failed/` directory.

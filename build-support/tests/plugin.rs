@@ -142,3 +142,17 @@ fn concurrent_builds_of_the_same_source() {
     assert_eq!(call_add(&outs[0].path, 2.0, 0.25), 2.25);
     assert!(leftovers(cache.path()).is_empty());
 }
+
+#[test]
+fn io_error_names_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    // A regular file where the cache directory should be.
+    let not_a_dir = dir.path().join("cache-is-a-file");
+    std::fs::write(&not_a_dir, b"").unwrap();
+    let err = build_plugin(ADD_SRC, &options(&not_a_dir)).unwrap_err();
+    assert!(
+        matches!(&err, BuildError::Io { path, .. } if path == &not_a_dir),
+        "{err}"
+    );
+    assert!(err.to_string().contains("cache-is-a-file"), "{err}");
+}
