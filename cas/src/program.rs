@@ -260,16 +260,59 @@ impl Builder {
         }
     }
 
-    /// `constant + Σ c·t` with negation folded into subtractions: positive terms are added
-    /// first, then the constant, then negative terms subtracted. With no positive part, a term
-    /// with |c| ≠ 1 takes the sign into its multiplication; only a sum of unit-negative terms
-    /// needs an explicit negation.
+    /// `constant + Σ c·t`. Terms with the same |c| ≠ 1 are grouped and multiplied once:
+    /// `c·a + c·b − c·d = c·(a + b − d)`. Negation is folded into subtractions: positive items
+    /// are added first, then the constant, then negative items subtracted. With no positive
+    /// part, an item with |c| ≠ 1 takes the sign into its multiplication; only a sum of
+    /// unit-negative terms needs an explicit negation.
     fn lower_sum(
         &mut self,
         constant: f64,
         terms: &[(ExprId, f64)],
         op: impl Fn(ExprId) -> Operand,
     ) -> Operand {
+        // Items: (operand, |coefficient|, negative?), groups in order of first appearance.
+        let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len());
+        let mut groups: Vec<(f64, Vec<Operand>, Vec<Operand>)> = Vec::new();
+        let mut group_of: FxMap<u64, usize> = FxMap::default();
+        for &(b, c) in terms {
+            let m = c.abs();
+            if m == 1.0 {
+                items.push((op(b), 1.0, c < 0.0));
+                continue;
+            }
+            let g = *group_of.entry(m.to_bits()).or_insert_with(|| {
+                groups.push((m, Vec::new(), Vec::new()));
+                groups.len() - 1
+            });
+            if c > 0.0 {
+                groups[g].1.push(op(b));
+            } else {
+                groups[g].2.push(op(b));
+            }
+        }
+        for (m, pos, neg) in groups {
+            let inner = match pos.split_first() {
+                Some((&first, rest)) => {
+                    let mut a = first;
+                    for &t in rest {
+                        a = self.emit(Instr::Add(a, t));
+                    }
+                    for &t in &neg {
+                        a = self.emit(Instr::Sub(a, t));
+                    }
+                    (a, false)
+                }
+                None => {
+                    let mut a = neg[0];
+                    for &t in &neg[1..] {
+                        a = self.emit(Instr::Add(a, t));
+                    }
+                    (a, true)
+                }
+            };
+            items.push((inner.0, m, inner.1));
+        }
         let scaled = |s: &mut Self, t: Operand, m: f64| {
             if m == 1.0 {
                 t
@@ -278,8 +321,8 @@ impl Builder {
             }
         };
         let mut acc: Option<Operand> = None;
-        for &(b, c) in terms.iter().filter(|t| t.1 > 0.0) {
-            let v = scaled(self, op(b), c);
+        for &(t, m, _) in items.iter().filter(|i| !i.2) {
+            let v = scaled(self, t, m);
             acc = Some(match acc {
                 None => v,
                 Some(a) => self.emit(Instr::Add(a, v)),
@@ -292,27 +335,31 @@ impl Builder {
                 Some(a) => self.emit(Instr::Sub(a, Operand::Const(-constant))),
             });
         }
-        let negs: Vec<(ExprId, f64)> = terms.iter().copied().filter(|t| t.1 < 0.0).collect();
+        let negs: Vec<(Operand, f64)> = items
+            .iter()
+            .filter(|i| i.2)
+            .map(|&(t, m, _)| (t, m))
+            .collect();
         let mut skip = usize::MAX;
         if acc.is_none() {
-            // All terms negative, no constant.
-            if let Some(i) = negs.iter().position(|t| t.1 != -1.0) {
-                acc = Some(scaled(self, op(negs[i].0), negs[i].1));
+            // Only negative items, no constant.
+            if let Some(i) = negs.iter().position(|t| t.1 != 1.0) {
+                acc = Some(scaled(self, negs[i].0, -negs[i].1));
                 skip = i;
             } else if negs.len() == 1 {
-                return self.emit(Instr::Neg(op(negs[0].0)));
+                return self.emit(Instr::Neg(negs[0].0));
             } else {
-                let mut a = op(negs[0].0);
-                for &(b, _) in &negs[1..] {
-                    a = self.emit(Instr::Add(a, op(b)));
+                let mut a = negs[0].0;
+                for &(t, _) in &negs[1..] {
+                    a = self.emit(Instr::Add(a, t));
                 }
                 return self.emit(Instr::Neg(a));
             }
         }
         let mut a = acc.unwrap_or(Operand::Const(0.0));
-        for (i, &(b, c)) in negs.iter().enumerate() {
+        for (i, &(t, m)) in negs.iter().enumerate() {
             if i != skip {
-                let v = scaled(self, op(b), -c);
+                let v = scaled(self, t, m);
                 a = self.emit(Instr::Sub(a, v));
             }
         }
@@ -324,9 +371,9 @@ impl Builder {
 /// inputs, constants and earlier temporaries (so the list is in topological order), each shared
 /// subexpression computed once.
 ///
-/// Lowering: n-ary sums and products become chains of binary operations; negative coefficients
-/// become subtractions; integer powers use binary powering with `x²` etc. shared between all
-/// uses; negative powers are collected into one division per product (`x⁻¹` becomes `1/x`).
+/// Lowering: n-ary sums and products become chains of binary operations; terms of a sum with
+/// the same coefficient are multiplied by it once; negative coefficients become subtractions;
+/// integer powers use binary powering with `x²` etc. shared between all uses; negative powers are collected into one division per product (`x⁻¹` becomes `1/x`).
 /// Equal instructions are emitted once (value numbering on top of the DAG's hash-consing).
 /// `sin` and `cos` of the same argument are separate instructions with the same operand;
 /// a code generator may pair them into `sin_cos` (see [`Program::sin_cos_pairs`]).

@@ -485,6 +485,24 @@ fn program_shares_and_lowers() {
         Operand::Const(-3.0),
         Operand::Sym(Symbol::q(0))
     )));
+    // equal coefficients are multiplied once: 2x + 2y − 2z + 3w = 2·(x + y − z) + 3w
+    let w = c.q(3);
+    let g = c.sum(0.0, &[(x, 2.0), (y, 2.0), (z, -2.0), (w, 3.0)]);
+    let p = Program::compile(&c, &[g]);
+    let n = p.op_counts();
+    assert_eq!((n.muls, n.adds), (2, 3), "{p}");
+    // only negative terms: −2x − 2y = (x + y)·(−2), −x − y = −(x + y)
+    let g1 = c.sum(0.0, &[(x, -2.0), (y, -2.0)]);
+    let g2 = c.sum(0.0, &[(x, -1.0), (y, -1.0)]);
+    let p = Program::compile(&c, &[g1, g2]);
+    let n = p.op_counts();
+    assert_eq!((n.muls, n.adds), (1, 2), "{p}");
+    let q4 = [0.5, 0.25, -1.0, 2.0];
+    let vals4 = Values {
+        q: &q4,
+        ..Default::default()
+    };
+    assert_eq!(p.eval(&vals4).unwrap(), vec![-1.5, -0.75]);
     // sin/cos pairing info
     let cz = c.cos(z);
     let p = Program::compile(&c, &[sz, cz]);
