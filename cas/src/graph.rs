@@ -500,6 +500,12 @@ impl Context {
 
     /// `a + b`.
     pub fn add(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        if a == ZERO {
+            return b;
+        }
+        if b == ZERO {
+            return a;
+        }
         self.sum(0.0, &[(a, 1.0), (b, 1.0)])
     }
 
@@ -682,6 +688,15 @@ impl Context {
 
     /// `a·b`.
     pub fn mul(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        if a == ZERO || b == ZERO {
+            return ZERO;
+        }
+        if a == ONE {
+            return b;
+        }
+        if b == ONE {
+            return a;
+        }
         self.product(&[(a, 1), (b, 1)])
     }
 

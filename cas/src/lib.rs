@@ -63,6 +63,13 @@
 //! [`Substitution`] replace symbols by expressions (memoized). [`Context::eval`] is the
 //! reference interpreter, with symbol values per kind in [`Values`].
 //!
+//! ## Kinematics helpers
+//!
+//! [`Mat3`] and [`Vec3`] are plain arrays of ids; [`Context::rot_x`], [`Context::rot_y`],
+//! [`Context::rot_z`] build elementary rotation matrices (body → parent), with
+//! [`Context::mat_mul`], [`Context::mat_vec`], [`Context::cross`], [`Context::dot`] for
+//! recursive kinematics.
+//!
 //! ## Straight-line code
 //!
 //! [`Program::compile`] lowers a list of outputs together into instructions
@@ -81,9 +88,11 @@
 mod calculus;
 mod eval;
 mod graph;
+mod linalg;
 mod program;
 
 pub use calculus::Substitution;
 pub use eval::{CasError, Values};
 pub use graph::{Context, Display, ExprId, Func, Node, ONE, Symbol, SymbolKind, ZERO};
+pub use linalg::{IDENTITY, Mat3, Vec3};
 pub use program::{Chunk, Instr, OpCounts, Operand, Program, SplitProgram};

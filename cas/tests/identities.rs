@@ -284,6 +284,52 @@ fn rotation_transpose_times_rotation_is_identity() {
 }
 
 #[test]
+fn linalg_helpers() {
+    use railmbs_cas::IDENTITY;
+    let mut c = Context::new();
+    let (a, b, _) = xyz(&mut c);
+    // every elementary rotation is orthogonal, and R(a)·R(−a) = I
+    let na = c.neg(a);
+    for k in 0..3 {
+        let r = match k {
+            0 => c.rot_x(a),
+            1 => c.rot_y(a),
+            _ => c.rot_z(a),
+        };
+        let rt = c.transpose(&r);
+        assert_eq!(c.mat_mul(&rt, &r), IDENTITY, "axis {k}");
+        let rn = match k {
+            0 => c.rot_x(na),
+            1 => c.rot_y(na),
+            _ => c.rot_z(na),
+        };
+        assert_eq!(c.mat_mul(&r, &rn), IDENTITY, "axis {k}");
+    }
+    // right-handed: R_z(a) maps e_x to (cos a, sin a, 0); e_x × e_y = e_z
+    let rz = c.rot_z(a);
+    let ex = [ONE, ZERO, ZERO];
+    let ey = [ZERO, ONE, ZERO];
+    assert_eq!(c.mat_vec(&rz, &ex), [c.cos(a), c.sin(a), ZERO]);
+    assert_eq!(c.cross(&ex, &ey), [ZERO, ZERO, ONE]);
+    // Rᵀ(R v) = v for a rotation two rotations deep (R v has sums as entries: the product is
+    // a product of sums, equal to v after the explicit expansion)
+    let rx = c.rot_x(b);
+    let r = c.mat_mul(&rz, &rx);
+    let v = [c.p(0), c.p(1), c.p(2)];
+    let w = c.mat_vec(&r, &v);
+    let back = c.mat_t_vec(&r, &w);
+    assert_eq!(back.map(|e| c.expand(e)), v);
+    // ω × r for ω = (0, 0, b), r = (a, 0, 0): (0, a·b, 0)
+    let om = [ZERO, ZERO, b];
+    let rr = [a, ZERO, ZERO];
+    assert_eq!(c.cross(&om, &rr), [ZERO, c.mul(a, b), ZERO]);
+    let s = c.vec_add(&ex, &ey);
+    assert_eq!(c.dot(&s, &s), c.num(2.0));
+    let two = c.num(2.0);
+    assert_eq!(c.vec_scale(two, &ex), [two, ZERO, ZERO]);
+}
+
+#[test]
 fn derivatives_of_elementary_functions() {
     let mut c = Context::new();
     let (x, y, _) = xyz(&mut c);
