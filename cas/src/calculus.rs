@@ -19,6 +19,12 @@ impl Context {
         r
     }
 
+    /// Frees the differentiation memo (one `u32` per node and variable differentiated by).
+    /// Later derivatives are recomputed (to the same nodes, by hash-consing).
+    pub fn clear_diff_cache(&mut self) {
+        self.diff_cache.clear();
+    }
+
     /// Jacobian `J[i][j] = ∂fs[i]/∂vars[j]`.
     pub fn jacobian(&mut self, fs: &[ExprId], vars: &[Symbol]) -> Vec<Vec<ExprId>> {
         let mut out = vec![Vec::with_capacity(vars.len()); fs.len()];

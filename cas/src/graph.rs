@@ -22,7 +22,7 @@ impl ExprId {
 pub enum SymbolKind {
     /// Generalized coordinate `q[i]` (m or rad).
     Coordinate,
-    /// Generalized velocity `v[i]` = dq[i]/dt (m/s or rad/s).
+    /// Generalized velocity `v[i]` = `dq[i]/dt` (m/s or rad/s).
     Velocity,
     /// Model parameter `p[i]` (any unit), a runtime input of the plugin.
     Parameter,

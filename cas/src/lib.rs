@@ -28,6 +28,30 @@
 //!   Non-finite values are never produced silently: [`Context::eval`], [`Program::eval`]
 //!   report them as [`CasError::NonFinite`].
 //!
+//! * **Cost.** Building a node costs O(k log k) in its operand count k (sort, merge, one hash
+//!   lookup); a node that exists already is found, not duplicated. Build long sums and
+//!   products with the n-ary [`Context::sum`], [`Context::add_many`], [`Context::product`],
+//!   [`Context::mul_many`]: folding them pairwise re-flattens at every step (quadratic).
+//!   Ids are `u32`: a context holds at most 2³² − 1 nodes (exceeding that panics with a
+//!   message; a rail vehicle model needs a few million at most).
+//!
+//! ## Example
+//!
+//! ```
+//! use railmbs_cas::{Context, Program, Symbol, Values};
+//!
+//! let mut c = Context::new();
+//! let (q, l) = (c.q(0), c.p(0));
+//! let s = c.sin(q);
+//! let x = c.mul(l, s); // x = l·sin q
+//! let dx = c.diff(x, Symbol::q(0)); // l·cos q
+//! let co = c.cos(q);
+//! assert_eq!(dx, c.mul(l, co));
+//! let prog = Program::compile(&c, &[x, dx]);
+//! let out = prog.eval(&Values { q: &[0.0], p: &[2.0], ..Default::default() }).unwrap();
+//! assert_eq!(out, vec![0.0, 2.0]);
+//! ```
+//!
 //! ## What the simplifier does on construction
 //!
 //! All rules are local and cheap (cost linear in the operand count of the node being built,
@@ -59,7 +83,8 @@
 //! ## Calculus, substitution, evaluation
 //!
 //! [`Context::diff`] differentiates with respect to a symbol, memoized per variable for the
-//! life of the context ([`Context::jacobian`] for many at once). [`Context::subs`] and
+//! life of the context ([`Context::jacobian`] for many at once; [`Context::clear_diff_cache`]
+//! frees the memo). [`Context::subs`] and
 //! [`Substitution`] replace symbols by expressions (memoized). [`Context::eval`] is the
 //! reference interpreter, with symbol values per kind in [`Values`].
 //!
