@@ -1,1 +1,72 @@
-fn main(){}
+//! Creep-force evaluations per second for each law (one core).
+//!
+//! `cargo bench -p railmbs-wheelrail --bench creep`; criterion reports the
+//! throughput in elements/s = evaluations/s over a fixed set of 64 tread-contact
+//! cases (creepages from adhesion-dominated to near saturation, spin up to
+//! 0.3 1/m).
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use railmbs_wheelrail::creep::{
+    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+};
+use std::hint::black_box;
+
+fn cases() -> Vec<Creepages> {
+    let mut v = Vec::new();
+    for xi in [0.0, 5e-4, 2e-3, 6e-3] {
+        for eta in [-1e-3, 0.0, 1e-3, 4e-3] {
+            for phi in [-0.3, -0.05, 0.1, 0.3] {
+                v.push(Creepages { xi, eta, phi });
+            }
+        }
+    }
+    v
+}
+
+fn bench(c: &mut Criterion) {
+    let p = ContactPatch {
+        a: 6e-3,
+        b: 4e-3,
+        g: 80e9,
+        nu: 0.28,
+        mu: 0.3,
+        n: 80e3,
+    };
+    let cs = cases();
+    let laws: Vec<(String, Box<dyn CreepLaw>)> = vec![
+        ("kalker".into(), Box::new(KalkerLinear)),
+        ("mueller".into(), Box::new(Mueller::default())),
+        (
+            "fastsim 10x10".into(),
+            Box::new(Fastsim::new(10, 10).unwrap()),
+        ),
+        (
+            "fastsim 10x20".into(),
+            Box::new(Fastsim::new(10, 20).unwrap()),
+        ),
+        (
+            "fastsim 20x20".into(),
+            Box::new(Fastsim::new(20, 20).unwrap()),
+        ),
+        ("fastsim-a 10".into(), Box::new(FastsimA::new(10).unwrap())),
+        ("fastsim-a 20".into(), Box::new(FastsimA::new(20).unwrap())),
+    ];
+    let mut g = c.benchmark_group("creep");
+    g.throughput(Throughput::Elements(cs.len() as u64));
+    for (name, law) in &laws {
+        g.bench_function(name.as_str(), |b| {
+            b.iter(|| {
+                let mut s = 0.0;
+                for c in &cs {
+                    let f = law.forces(black_box(&p), black_box(c)).unwrap();
+                    s += f.fx + f.fy + f.mz;
+                }
+                s
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

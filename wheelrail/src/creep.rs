@@ -219,7 +219,7 @@ impl CreepLaw for Mueller {
         if limit <= 0.0 {
             return Ok(CreepForces::default());
         }
-        let u = lin.fx.hypot(lin.fy) / limit;
+        let u = (lin.fx * lin.fx + lin.fy * lin.fy).sqrt() / limit;
         let s = if u == 0.0 {
             1.0
         } else if u > 1e8 {

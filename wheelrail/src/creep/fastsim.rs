@@ -53,12 +53,19 @@ pub enum FastsimLayout {
 }
 
 /// Kalker's FASTSIM with `strips` × `elements`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Fastsim {
     strips: usize,
     elements: usize,
     bound: TractionBound,
     layout: FastsimLayout,
+    /// Per strip: (η = y/b at the strip centre, √(1 − η²) = a_y/a).
+    strip_geom: Vec<(f64, f64)>,
+    /// Discrete integral of (1 − x² − η²) over the unit ellipse (a = b = 1) by
+    /// the strip layout's midpoint rule, and of √(1 − x² − η²); the pressure
+    /// integrals for semi-axes a, b are these times a·b.
+    norm_parabolic: f64,
+    norm_elliptic: f64,
 }
 
 /// Largest number of strips or elements per strip accepted.
@@ -75,11 +82,39 @@ impl Fastsim {
                 )));
             }
         }
+        let mf = strips as f64;
+        let nf = elements as f64;
+        let strip_geom: Vec<(f64, f64)> = (0..strips)
+            .map(|j| {
+                let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
+                (e, (1.0 - e * e).max(0.0).sqrt())
+            })
+            .collect();
+        let dy = 2.0 / mf;
+        // Midpoint rule of ∫(s² − x²)dx over n elements = (4/3)s³(1 + 1/(2n²)).
+        let norm_parabolic = strip_geom.iter().map(|&(_, sj)| sj * sj * sj).sum::<f64>()
+            * (4.0 / 3.0)
+            * (1.0 + 0.5 / (nf * nf))
+            * dy;
+        let mut norm_elliptic = 0.0;
+        for &(_, sj) in &strip_geom {
+            let h = 2.0 * sj / nf;
+            let acc: f64 = (0..elements)
+                .map(|i| {
+                    let x = sj - (i as f64 + 0.5) * h;
+                    (sj * sj - x * x).max(0.0).sqrt()
+                })
+                .sum();
+            norm_elliptic += acc * h * dy;
+        }
         Ok(Self {
             strips,
             elements,
             bound: TractionBound::Parabolic,
             layout: FastsimLayout::Strips,
+            strip_geom,
+            norm_parabolic,
+            norm_elliptic,
         })
     }
 
@@ -105,79 +140,86 @@ impl Fastsim {
 
     /// Strip layout; inputs already validated, `N > 0`, `μ > 0`.
     #[inline]
-    fn eval_strips(&self, p: &ContactPatch, c: &Creepages, fl: &Flexibilities) -> CreepForces {
-        let m = self.strips;
+    fn eval_strips<const ELLIPTIC: bool>(
+        &self,
+        p: &ContactPatch,
+        c: &Creepages,
+        fl: &Flexibilities,
+    ) -> CreepForces {
         let n = self.elements;
-        let dy = 2.0 * p.b / m as f64;
+        let dy = 2.0 * p.b / self.strips as f64;
         let nf = n as f64;
-        let strip_half = |j: usize| {
-            let eta = -1.0 + (j as f64 + 0.5) * 2.0 / m as f64;
-            p.a * (1.0 - eta * eta).max(0.0).sqrt()
+        // Normalisation: the discrete integral of p_n equals N; p_n = gk/μ·(aⱼ² − x²)
+        // (parabolic) or gk/μ·√(aⱼ² − x²) (elliptic); the unit-ellipse sums scale
+        // with a·b·a² resp. a·b·a.
+        let gk = if ELLIPTIC {
+            p.mu * p.n / (self.norm_elliptic * p.a * p.a * p.b)
+        } else {
+            p.mu * p.n / (self.norm_parabolic * p.a * p.a * p.a * p.b)
         };
-        // Normalisation: discrete integral of p_n equals N.
-        let gk = match self.bound {
-            TractionBound::Parabolic => {
-                // Midpoint rule of ∫(aⱼ² − x²)dx over n elements = (4/3)aⱼ³(1 + 1/(2n²)).
-                let s: f64 = (0..m).map(|j| strip_half(j).powi(3)).sum::<f64>()
-                    * (4.0 / 3.0)
-                    * (1.0 + 0.5 / (nf * nf))
-                    * dy;
-                p.mu * p.n / s
-            }
-            TractionBound::Elliptic => {
-                let mut s = 0.0;
-                for j in 0..m {
-                    let aj = strip_half(j);
-                    let h = 2.0 * aj / nf;
-                    let mut acc = 0.0;
-                    for i in 0..n {
-                        let x = aj - (i as f64 + 0.5) * h;
-                        acc += (aj * aj - x * x).max(0.0).sqrt();
-                    }
-                    s += acc * h;
-                }
-                p.mu * p.n / (s * dy)
-            }
-        };
-        let wx_rate_xi = c.xi * fl.inv_l1;
+        let wx_xi = c.xi * fl.inv_l1;
         let wy0 = c.eta * fl.inv_l2;
         let cs = c.phi * fl.inv_l3;
+        // Strips are processed LANES at a time, interleaved, so that the
+        // loop-carried dependency of each strip (traction → bound → traction)
+        // overlaps with the others; saturation is branch-free.
+        const LANES: usize = 4;
         let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
-        for j in 0..m {
-            let y = -p.b + (j as f64 + 0.5) * dy;
-            let aj = strip_half(j);
-            let h = 2.0 * aj / nf;
-            let wxr = wx_rate_xi - c.phi * y * fl.inv_l3;
-            // Leading edge to the first element centre: half an element.
-            let mut x = aj - 0.5 * h;
-            let mut px = wxr * 0.5 * h;
-            let mut py = (wy0 + cs * (aj - 0.25 * h)) * 0.5 * h;
-            let (mut sx, mut sy, mut sm) = (0.0, 0.0, 0.0);
-            for i in 0..n {
-                if i > 0 {
-                    px += wxr * h;
-                    py += (wy0 + cs * (x - 0.5 * h)) * h;
-                    x -= h;
-                }
-                let q = (aj * aj - x * x).max(0.0);
-                let g = match self.bound {
-                    TractionBound::Parabolic => gk * q,
-                    TractionBound::Elliptic => gk * q.sqrt(),
-                };
-                let t2 = px * px + py * py;
-                if t2 > g * g {
-                    let s = g / t2.sqrt();
-                    px *= s;
-                    py *= s;
-                }
-                sx += px;
-                sy += py;
-                sm += x * py;
+        for chunk in self.strip_geom.chunks(LANES) {
+            let mut y = [0.0; LANES];
+            let mut a2 = [0.0; LANES];
+            let mut h = [0.0; LANES];
+            let mut wxh = [0.0; LANES];
+            let mut csh2 = [0.0; LANES];
+            let mut x = [0.0; LANES];
+            let mut px = [0.0; LANES];
+            let mut py = [0.0; LANES];
+            let mut dpy = [0.0; LANES];
+            for (l, &(e, sj)) in chunk.iter().enumerate() {
+                y[l] = e * p.b;
+                let aj = p.a * sj;
+                a2[l] = aj * aj;
+                h[l] = 2.0 * aj / nf;
+                wxh[l] = (wx_xi - c.phi * y[l] * fl.inv_l3) * h[l];
+                csh2[l] = cs * h[l] * h[l];
+                // Leading edge to the first element centre: half an element.
+                x[l] = aj - 0.5 * h[l];
+                px[l] = 0.5 * wxh[l];
+                py[l] = (wy0 + cs * (aj - 0.25 * h[l])) * 0.5 * h[l];
+                // Slip increment per element: (wy0 + cs·(x − h/2))·h.
+                dpy[l] = (wy0 + cs * (x[l] - 0.5 * h[l])) * h[l];
             }
-            let w = h * dy;
-            fx += sx * w;
-            fy += sy * w;
-            mz += (sm - y * sx) * w;
+            let mut sx = [0.0; LANES];
+            let mut sy = [0.0; LANES];
+            let mut sm = [0.0; LANES];
+            for _ in 0..n {
+                for l in 0..LANES {
+                    let q = a2[l] - x[l] * x[l];
+                    let g = if ELLIPTIC {
+                        gk * q.max(0.0).sqrt()
+                    } else {
+                        gk * q
+                    };
+                    let t2 = px[l] * px[l] + py[l] * py[l];
+                    // min ignores the NaN of 0/0 (lane unused or zero traction).
+                    let s = (g / t2.sqrt()).min(1.0);
+                    px[l] *= s;
+                    py[l] *= s;
+                    sx[l] += px[l];
+                    sy[l] += py[l];
+                    sm[l] += x[l] * py[l];
+                    px[l] += wxh[l];
+                    py[l] += dpy[l];
+                    dpy[l] -= csh2[l];
+                    x[l] -= h[l];
+                }
+            }
+            for l in 0..chunk.len() {
+                let w = h[l] * dy;
+                fx += sx[l] * w;
+                fy += sy[l] * w;
+                mz += (sm[l] - y[l] * sx[l]) * w;
+            }
         }
         CreepForces {
             fx: -fx,
@@ -252,7 +294,10 @@ impl CreepLaw for Fastsim {
         }
         let fl = Flexibilities::new(p, &k);
         Ok(match self.layout {
-            FastsimLayout::Strips => self.eval_strips(p, c, &fl),
+            FastsimLayout::Strips => match self.bound {
+                TractionBound::Parabolic => self.eval_strips::<false>(p, c, &fl),
+                TractionBound::Elliptic => self.eval_strips::<true>(p, c, &fl),
+            },
             FastsimLayout::UniformGrid { scale } => self.eval_grid(p, c, &fl, scale),
         })
     }
