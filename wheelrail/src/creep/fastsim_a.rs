@@ -208,7 +208,7 @@ fn sliding(aj: f64, y: f64, aa: f64, bb: f64, cc: f64, kk: f64, x1: f64, x2: f64
             return StripSums::default();
         }
     }
-    let mut out;
+    let out;
     let turn = (two_c * ell).abs();
     if turn <= 0.02 * wmid {
         // Direction nearly constant over the zone (it turns by < 0.02 rad):
