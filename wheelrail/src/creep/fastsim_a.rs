@@ -208,7 +208,6 @@ fn sliding(aj: f64, y: f64, aa: f64, bb: f64, cc: f64, kk: f64, x1: f64, x2: f64
             return StripSums::default();
         }
     }
-    let out;
     let turn = (two_c * ell).abs();
     if turn <= 0.02 * wmid {
         // Direction nearly constant over the zone (it turns by < 0.02 rad):
@@ -240,11 +239,11 @@ fn sliding(aj: f64, y: f64, aa: f64, bb: f64, cc: f64, kk: f64, x1: f64, x2: f64
         let fx = e0x * m0 + d1x * m1 + d2x * m2;
         let fy = e0y * m0 + d1y * m1 + d2y * m2;
         let xfy = xm * fy + e0y * m1 + d1y * m2 + d2y * m3;
-        out = StripSums {
+        StripSums {
             fx,
             fy,
             mz: xfy - y * fx,
-        };
+        }
     } else {
         // Closed form in u = B + 2Cx; x = (u − B)/(2C), dx = du/(2C).
         // g = K P(u), P = α0 + α1 u + α2 u².
@@ -266,9 +265,8 @@ fn sliding(aj: f64, y: f64, aa: f64, bb: f64, cc: f64, kk: f64, x1: f64, x2: f64
         let fy = f * ip1;
         // x p_y − y p_x: x u = (u² − B u)/(2C).
         let mzz = f * ((ip2 - bb * ip1) * inv2c - y * aa * ip0);
-        out = StripSums { fx, fy, mz: mzz };
+        StripSums { fx, fy, mz: mzz }
     }
-    out
 }
 
 impl CreepLaw for FastsimA {
