@@ -616,15 +616,23 @@ impl Context {
             return false;
         }
         // Cheap filter: only arguments that appear squared under both sin and cos.
-        sins.retain(|s| coss.iter().any(|c| c.1 == s.1));
-        if sins.is_empty() {
+        let sin_args: std::collections::HashSet<ExprId, FxBuild> =
+            sins.iter().map(|s| s.1).collect();
+        coss.retain(|c| sin_args.contains(&c.1));
+        if coss.is_empty() {
             return false;
         }
-        coss.retain(|c| sins.iter().any(|s| s.1 == c.1));
-        let mut sin_rest: Vec<(usize, ExprId, ExprId)> = Vec::with_capacity(sins.len());
+        let cos_args: std::collections::HashSet<ExprId, FxBuild> =
+            coss.iter().map(|c| c.1).collect();
+        sins.retain(|s| cos_args.contains(&s.1));
+        // (argument, remainder, coefficient bits) → sine terms with that key.
+        let mut by_key: FxMap<(ExprId, ExprId, u64), Vec<usize>> = FxMap::default();
         for &(i, u, j) in &sins {
             let r = self.remove_square(terms[i].0, j);
-            sin_rest.push((i, u, r));
+            by_key
+                .entry((u, r, terms[i].1.to_bits()))
+                .or_default()
+                .push(i);
         }
         let mut used = vec![false; terms.len()];
         let mut new_terms = Vec::new();
@@ -634,9 +642,10 @@ impl Context {
             }
             let r = self.remove_square(terms[i].0, j);
             let c = terms[i].1;
-            if let Some(&(si, _, _)) = sin_rest.iter().find(|&&(si, su, sr)| {
-                !used[si] && si != i && su == u && sr == r && terms[si].1.to_bits() == c.to_bits()
-            }) {
+            if let Some(list) = by_key.get_mut(&(u, r, c.to_bits()))
+                && let Some(pos) = list.iter().position(|&si| !used[si] && si != i)
+            {
+                let si = list.swap_remove(pos);
                 used[si] = true;
                 used[i] = true;
                 new_terms.push((r, c));
