@@ -140,6 +140,50 @@ impl MechanicalSystem for Pendulum {
     }
 }
 
+/// Two free masses on a line; the first is driven along x₁ = A sin ωt by a
+/// rheonomic constraint g(q, t) = x₁ − A sin ωt = 0, the second moves freely.
+/// The multiplier is the driving force: λ = m ẍ₁ = −m A ω² sin ωt.
+struct Driven {
+    m: f64,
+    amp: f64,
+    omega: f64,
+}
+
+impl MechanicalSystem for Driven {
+    fn dof(&self) -> usize {
+        2
+    }
+    fn n_constraints(&self) -> usize {
+        1
+    }
+    fn dynamics(
+        &mut self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        mass.fill(0.0);
+        mass[(0, 0)] = self.m;
+        mass[(1, 1)] = self.m;
+        force.fill(0.0);
+        Ok(())
+    }
+    fn constraints(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        g: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), SimError> {
+        g[0] = q[0] - self.amp * (self.omega * t).sin();
+        jacobian[(0, 0)] = 1.0;
+        jacobian[(0, 1)] = 0.0;
+        Ok(())
+    }
+}
+
 /// q̈ = q³: from q0 = 1, q̇0 = 1/√2 (zero energy ½q̇² − ¼q⁴) the solution is
 /// q = 1/(1 − t/√2), which blows up at t* = √2.
 struct BlowUp;
@@ -747,6 +791,85 @@ fn inconsistent_pendulum_start_is_projected_onto_the_constraints() {
         "{lambda} vs {tension}"
     );
     assert_eq!(st.t, 0.1);
+}
+
+#[test]
+fn rheonomic_constraint_drives_the_motion_and_lambda_is_the_driving_force() {
+    let mut sys = Driven {
+        m: 2.0,
+        amp: 0.1,
+        omega: 5.0,
+    };
+    let (m, amp, w) = (sys.m, sys.amp, sys.omega);
+    let tol = 1e-8;
+    let (mut worst_x, mut worst_v, mut worst_force, mut worst_free) =
+        (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
+    let mut h_max = 0.0_f64;
+    // Both masses start at rest: v0 is projected onto G v + ∂g/∂t = 0, which
+    // gives the driven mass its velocity A ω and leaves the free one alone.
+    let st = Park::new(ParkSettings::with_tolerances(tol, tol))
+        .run(&mut sys, 0.0, &[0.0, 0.3], &[0.0, 0.0], 2.0, |s| {
+            let t = s.t;
+            h_max = h_max.max(s.h);
+            worst_x = worst_x.max((s.q[0] - amp * (w * t).sin()).abs());
+            worst_v = worst_v.max((s.v[0] - amp * w * (w * t).cos()).abs());
+            worst_force = worst_force.max((s.lambda[0] + m * amp * w * w * (w * t).sin()).abs());
+            worst_free = worst_free.max((s.q[1] - 0.3).abs()).max(s.v[1].abs());
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+    println!(
+        "driven: x {worst_x:e}, v {worst_v:e}, force {worst_force:e}, free {worst_free:e}, {st:?}"
+    );
+    // The constraint is imposed exactly on positions at every step.
+    assert!(worst_x < 1e-12, "{worst_x}");
+    // With exact positions v = D q carries only Park's truncation error
+    // |q'''|·h₀(h₀ + h₁)/12 ≤ A ω³ h²/6 (module docs); 1.5× for step variation.
+    let v_bound = 1.5 * amp * w.powi(3) * h_max * h_max / 6.0;
+    assert!(worst_v < v_bound, "{worst_v} vs {v_bound}");
+    // Driving force amplitude m A ω² = 5 N. a = D(D q) reacts to each step
+    // size change by ~h·|q'''|·|Δh/h| (the truncation error of v changes with
+    // the step, and D divides that change by h): with h ≈ 2.5e-3 s and
+    // changes up to 20 %, ~1e-2 N at most; allow 2.5e-3 relative.
+    assert!(worst_force < 2.5e-3 * m * amp * w * w, "{worst_force}");
+    // The free mass is not coupled at all.
+    assert!(worst_free < 1e-12, "{worst_free}");
+}
+
+#[test]
+fn too_large_initial_step_is_recovered_by_newton_failure_or_error_test() {
+    // A 0.5 s first step on the pendulum (a quarter period) must be refused by
+    // Newton or by the error test and reduced; the run then stays accurate.
+    let mut p = Pendulum {
+        m: 1.0,
+        l: 1.0,
+        g: 9.81,
+    };
+    let theta0 = 1.0_f64;
+    let settings = ParkSettings {
+        initial_step: Some(0.5),
+        ..ParkSettings::with_tolerances(1e-7, 1e-7)
+    };
+    let e0 = -p.g * theta0.cos();
+    let mut worst_energy = 0.0_f64;
+    let st = Park::new(settings)
+        .run(
+            &mut p,
+            0.0,
+            &[theta0.sin(), -theta0.cos()],
+            &[0.0, 0.0],
+            3.0,
+            |s| {
+                let energy = 0.5 * (s.v[0] * s.v[0] + s.v[1] * s.v[1]) + 9.81 * s.q[1];
+                worst_energy = worst_energy.max((energy - e0).abs());
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+    println!("large first step: energy {worst_energy:e}, {st:?}");
+    assert!(st.rejected_steps >= 1, "{st:?}");
+    // Energy g l (1 − cos θ0) ≈ 4.5 J per kg conserved to 1e-4 relative.
+    assert!(worst_energy < 1e-4 * p.g, "{worst_energy}");
 }
 
 // ---------------------------------------------------------------------------
