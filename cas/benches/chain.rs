@@ -108,25 +108,53 @@ fn derive(n: usize) -> Derived {
     Derived { ctx: c, outputs }
 }
 
+/// CPU time of the current thread in ns (Linux `/proc/thread-self/schedstat`), if available:
+/// less sensitive than wall time to other processes on a loaded machine.
+fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
 fn report(n: usize) {
-    let t0 = Instant::now();
     let d = derive(n);
-    let t1 = Instant::now();
     let prog = Program::compile(&d.ctx, &d.outputs);
-    let t2 = Instant::now();
     let tree = d.ctx.tree_op_counts(&d.outputs);
     let after = prog.op_counts();
     println!(
-        "chain N={n}: {} outputs, {} DAG nodes; derive {:.2} ms, CSE {:.2} ms (single run)",
+        "chain N={n}: {} outputs, {} DAG nodes",
         d.outputs.len(),
-        d.ctx.len(),
-        (t1 - t0).as_secs_f64() * 1e3,
-        (t2 - t1).as_secs_f64() * 1e3
+        d.ctx.len()
     );
     println!("  operations before CSE (tree): {tree}");
     println!(
         "  operations after CSE:         {after} in {} instructions",
         prog.instrs.len()
+    );
+    // mean over repeated runs: wall time and this thread's CPU time
+    let runs = 10;
+    let (mut wall_d, mut wall_c, mut cpu_d, mut cpu_c) = (0.0, 0.0, 0u64, 0u64);
+    for _ in 0..runs {
+        let (t0, c0) = (Instant::now(), thread_cpu_ns());
+        let d = derive(n);
+        let (t1, c1) = (Instant::now(), thread_cpu_ns());
+        let p = Program::compile(&d.ctx, &d.outputs);
+        let (t2, c2) = (Instant::now(), thread_cpu_ns());
+        black_box(p.instrs.len());
+        wall_d += (t1 - t0).as_secs_f64();
+        wall_c += (t2 - t1).as_secs_f64();
+        if let (Some(c0), Some(c1), Some(c2)) = (c0, c1, c2) {
+            cpu_d += c1 - c0;
+            cpu_c += c2 - c1;
+        }
+    }
+    let ms = |x: f64| x * 1e3 / runs as f64;
+    let cpu_ms = |x: u64| x as f64 * 1e-6 / runs as f64;
+    println!(
+        "  mean of {runs}: derive M,k {:.2} ms wall / {:.2} ms CPU; CSE {:.2} ms wall / {:.2} ms CPU",
+        ms(wall_d),
+        cpu_ms(cpu_d),
+        ms(wall_c),
+        cpu_ms(cpu_c)
     );
 }
 

@@ -100,7 +100,7 @@ impl Context {
                         continue;
                     }
                     let mut fs: Vec<(ExprId, i32)> = factors.to_vec();
-                    fs[i].1 -= 1;
+                    fs[i].1 = fs[i].1.saturating_sub(1);
                     fs.push((db, 1));
                     let p = self.product(&fs);
                     ts.push((p, k as f64));

@@ -780,7 +780,7 @@ impl Context {
             .iter()
             .enumerate()
             .find_map(|(i, &(f, k))| match self.node(f) {
-                Node::Call(Func::Sqrt, u) if k.abs() >= 2 => Some((i, *u)),
+                Node::Call(Func::Sqrt, u) if k.unsigned_abs() >= 2 => Some((i, *u)),
                 _ => None,
             })
         {

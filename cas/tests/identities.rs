@@ -575,6 +575,15 @@ fn split_program_matches_and_reuses_slots() {
         ..Default::default()
     };
     let want = prog.eval(&vals).unwrap();
+    // a program without instructions (outputs are an input and a constant)
+    let p0 = Program::compile(&c, &[qs[0], ONE]);
+    assert!(p0.instrs.is_empty());
+    let sp0 = p0.split(4).unwrap();
+    assert_eq!(sp0.eval(&p0, &vals).unwrap(), vec![q[0], 1.0]);
+    // extreme exponents do not overflow
+    let big = c.powi(qs[0], i32::MIN);
+    let d = c.diff(big, Symbol::q(0));
+    assert_ne!(d, ZERO);
     let last = prog.last_uses();
     assert_eq!(last.len(), prog.instrs.len());
     for max in 1..=prog.instrs.len() + 1 {
