@@ -685,6 +685,33 @@ impl Profile {
         })
     }
 
+    /// Height `h(u)` (m) using and updating a segment hint `seg` (fast for monotone sweeps
+    /// over `u`); `None` outside the range.
+    #[inline]
+    pub fn height_hinted(&self, u: f64, seg: &mut usize) -> Option<f64> {
+        let n = self.knots.len();
+        if !(u >= self.knots[0] && u <= self.knots[n - 1]) {
+            return None;
+        }
+        let mut i = (*seg).min(n - 2);
+        let mut steps = 0;
+        while u < self.knots[i] && steps < 8 {
+            i -= 1;
+            steps += 1;
+        }
+        while u >= self.knots[i + 1] && i + 2 < n && steps < 8 {
+            i += 1;
+            steps += 1;
+        }
+        if !(u >= self.knots[i] && (u < self.knots[i + 1] || i + 2 == n)) {
+            i = self.knots.partition_point(|&k| k <= u).clamp(1, n - 1) - 1;
+        }
+        *seg = i;
+        let t = u - self.knots[i];
+        let [a, b, c, d] = self.coef[i];
+        Some(a + t * (b + t * (c + t * d)))
+    }
+
     /// Height `h(u)` (m); `None` outside the range.
     pub fn height(&self, u: f64) -> Option<f64> {
         self.eval(u).map(|v| v.h)
