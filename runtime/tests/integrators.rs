@@ -14,6 +14,40 @@ use railmbs_runtime::integrate::{
 use railmbs_runtime::{MechanicalSystem, SimError};
 
 // ---------------------------------------------------------------------------
+// Allocation counting (per thread, so parallel tests do not interfere)
+// ---------------------------------------------------------------------------
+
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+// SAFETY: forwards every call unchanged to the system allocator; the
+// thread-local counter is const-initialized and has no destructor, so it
+// never allocates itself.
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+// ---------------------------------------------------------------------------
 // Test systems
 // ---------------------------------------------------------------------------
 
@@ -422,6 +456,28 @@ fn jacobian_kinds_agree_and_analytic_saves_evaluations() {
     assert_eq!(per_jac(&results[0]), 3 * results[0].2.jacobian_evaluations);
     assert_eq!(per_jac(&results[1]), 5 * results[1].2.jacobian_evaluations);
     assert_eq!(per_jac(&results[2]), results[2].2.jacobian_evaluations);
+
+    // A system without analytic Jacobians falls back to forward differences.
+    let mut sys = Oscillator::new(m, c, k);
+    let settings = ParkSettings {
+        jacobian: JacobianKind::Analytic,
+        ..ParkSettings::with_tolerances(1e-7, 1e-7)
+    };
+    let st = integrate_park(
+        &mut sys,
+        &settings,
+        0.0,
+        &[1.0],
+        &[0.0],
+        1.0,
+        |_, _, _, _| ControlFlow::Continue(()),
+    )
+    .unwrap();
+    assert_eq!(st.q, results[0].2.q);
+    assert_eq!(
+        st.dynamics_evaluations - st.newton_iterations - 2,
+        3 * st.jacobian_evaluations
+    );
 }
 
 // ---------------------------------------------------------------------------
@@ -870,6 +926,60 @@ fn too_large_initial_step_is_recovered_by_newton_failure_or_error_test() {
     assert!(st.rejected_steps >= 1, "{st:?}");
     // Energy g l (1 − cos θ0) ≈ 4.5 J per kg conserved to 1e-4 relative.
     assert!(worst_energy < 1e-4 * p.g, "{worst_energy}");
+}
+
+#[test]
+fn step_loops_do_not_allocate() {
+    // Allocations of a whole run must not depend on the number of steps: runs
+    // to 1 s and to 4 s (4× the steps) allocate the same amount (workspaces
+    // at the start, the returned statistics).
+    let count = |t_end: f64, which: u8| {
+        let before = allocations();
+        match which {
+            0 => {
+                let mut sys = Oscillator::new(1.0, 0.1, 100.0);
+                let s = ParkSettings::with_tolerances(1e-7, 1e-7);
+                let st = integrate_park(&mut sys, &s, 0.0, &[1.0], &[0.0], t_end, |_, _, _, _| {
+                    ControlFlow::Continue(())
+                })
+                .unwrap();
+                assert_eq!(st.newton_failures, 0);
+            }
+            1 => {
+                let mut p = Pendulum {
+                    m: 1.0,
+                    l: 1.0,
+                    g: 9.81,
+                };
+                Park::new(ParkSettings::fixed(1e-3))
+                    .run(&mut p, 0.0, &[0.6, -0.8], &[0.0, 0.0], t_end, |_| {
+                        ControlFlow::Continue(())
+                    })
+                    .unwrap();
+            }
+            _ => {
+                let mut sys = Oscillator::new(1.0, 0.1, 100.0);
+                integrate_rk4(
+                    &mut sys,
+                    &Rk4Settings::new(1e-3),
+                    0.0,
+                    &[1.0],
+                    &[0.0],
+                    t_end,
+                    |_, _, _, _| ControlFlow::Continue(()),
+                )
+                .unwrap();
+            }
+        }
+        allocations() - before
+    };
+    for which in 0..3 {
+        let (a1, a4) = (count(1.0, which), count(4.0, which));
+        assert_eq!(
+            a1, a4,
+            "integrator {which}: {a1} allocations to 1 s, {a4} to 4 s"
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------

@@ -761,10 +761,9 @@ impl Work {
             st.newton_iterations += 1;
             self.eval_dynamics(system, t, st)?;
             if nc > 0 {
-                let q = std::mem::replace(&mut self.q, DVector::zeros(0));
-                let r = self.eval_constraints(system, t, &q);
-                self.q = q;
-                r?;
+                system.constraints(t, self.q.as_slice(), &mut self.gval, &mut self.gjac)?;
+                check_finite(t, "constraint residual g", self.gval.as_slice())?;
+                check_finite(t, "constraint Jacobian G", self.gjac.as_slice())?;
             }
             // rhs = [−β² (M a − f − Gᵀλ); −g]
             {
