@@ -1,1 +1,496 @@
-//! (being written)
+//! Massless elastic rail (seed paper Sect. 4.2): the rail head of one rail is a
+//! massless body that moves laterally and vertically against springs and
+//! dampers to ground, and is in quasi-static equilibrium with the wheel–rail
+//! contact forces at every instant.
+//!
+//! In the cross-section plane of the rail (y lateral, z up, as the track frame)
+//! the rail displacement `d = (d_y, d_z)` satisfies
+//!
+//! ```text
+//! k_y d_y + c_y ḋ_y = −Σᵢ F_y,i        (lateral equilibrium)
+//! k_z d_z + c_z ḋ_z = −Σᵢ F_z,i        (vertical equilibrium)
+//! ```
+//!
+//! where `Fᵢ = Nᵢ nᵢ + Tᵢ tᵢ` is the force of contact `i` on the wheel (normal
+//! force `Nᵢ` along the normal `nᵢ` from rail to wheel, lateral creep force `Tᵢ`
+//! along the in-plane tangent `tᵢ = (n_z, −n_y)`, i.e. `eᵧ` of the contact
+//! frame); the rail receives `−Fᵢ`. The damping rate is discretised over the
+//! caller's time step, `ḋ ≈ (d − d_prev)/h` (backward Euler; `h = ∞` gives the
+//! static problem).
+//!
+//! The normal force of each contact follows Hertz, `Nᵢ = (δᵢ/δ₁)^{3/2}` with the
+//! approach `δᵢ(d)` from the contact geometry at the displaced rail (one- or
+//! two-point contact). Solution as in the paper:
+//!
+//! - **inner iterations**: with the creep forces fixed, Newton on the 2×2
+//!   equilibrium for `d` (Jacobian `K + C/h + Σ (dN/dδ)·nnᵀ`), which gives the
+//!   rail deformation and the normal forces;
+//! - **outer iterations**: with the new normal forces, the contact ellipses and
+//!   the creep forces are recomputed (the rail's own velocity enters the lateral
+//!   creepage), and the inner problem is solved again, until the normal and
+//!   creep forces change by less than the tolerance.
+//!
+//! The contact geometry is supplied through [`RailContactGeometry`] — "the
+//! contact geometry at a given rail displacement" — which the wheelset contact
+//! geometry ([`crate::geometry`]) can implement; [`LinearizedContacts`] is a
+//! first-order implementation from the geometry at zero displacement.
+
+use crate::creep::{ContactPatch, CreepForces, CreepLaw, Creepages};
+use crate::hertz::HertzShape;
+
+/// Most contacts per wheel (tread and flange).
+pub const MAX_CONTACTS: usize = 2;
+
+/// Errors of the elastic-rail solution.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ElasticRailError {
+    /// Bad support or solver parameter.
+    #[error("elastic rail: {0}")]
+    Parameter(String),
+    /// The geometry reported something unusable.
+    #[error("elastic rail: contact {index}: {what}")]
+    Geometry {
+        /// Contact index.
+        index: usize,
+        /// What is wrong.
+        what: String,
+    },
+    /// A creep law or Hertz failed.
+    #[error("elastic rail: contact {index}: {message}")]
+    Contact {
+        /// Contact index.
+        index: usize,
+        /// The underlying error's message.
+        message: String,
+    },
+    /// No convergence.
+    #[error(
+        "elastic rail: {kind} iterations did not converge in {iterations} (residual {residual:e})"
+    )]
+    NoConvergence {
+        /// `inner` or `outer`.
+        kind: &'static str,
+        /// Iterations made.
+        iterations: usize,
+        /// Last residual (N for inner, relative for outer).
+        residual: f64,
+    },
+}
+
+/// Stiffness and damping of the rail support at the contact, per rail.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RailSupport {
+    /// Lateral stiffness, N/m (> 0).
+    pub ky: f64,
+    /// Lateral damping, N·s/m (≥ 0).
+    pub cy: f64,
+    /// Vertical stiffness, N/m (> 0).
+    pub kz: f64,
+    /// Vertical damping, N·s/m (≥ 0).
+    pub cz: f64,
+}
+
+/// Geometry of one wheel–rail contact at a given rail displacement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RailContact {
+    /// Approach (geometric overlap of the undeformed surfaces along the normal),
+    /// m; no contact if ≤ 0.
+    pub approach: f64,
+    /// Unit normal from rail into wheel, `(n_y, n_z)` in the rail cross-section.
+    pub normal: [f64; 2],
+    /// Hertz shape from the contact's curvatures and materials.
+    pub hertz: HertzShape,
+    /// Creepages for a rigid rail at rest (the rail's own velocity is added by
+    /// the solver).
+    pub creepages: Creepages,
+}
+
+/// "Contact geometry at a given rail displacement": writes the contacts (at
+/// most [`MAX_CONTACTS`]) of the wheel on the rail displaced by `d = (d_y, d_z)`
+/// (m) and returns how many there are.
+pub trait RailContactGeometry {
+    /// Contacts at rail displacement `d`.
+    fn contacts_at(&self, d: [f64; 2], out: &mut [RailContact; MAX_CONTACTS]) -> usize;
+}
+
+/// First-order contact geometry: the contacts at zero rail displacement, with
+/// the approach changing as `δ(d) = δ₀ + n·d` (moving the rail along its normal
+/// into the wheel increases the overlap) and normals, curvatures and creepages
+/// kept — adequate for rail displacements small against the profile radii.
+#[derive(Debug, Clone)]
+pub struct LinearizedContacts {
+    /// The contacts at `d = 0`.
+    pub contacts: Vec<RailContact>,
+}
+
+impl RailContactGeometry for LinearizedContacts {
+    fn contacts_at(&self, d: [f64; 2], out: &mut [RailContact; MAX_CONTACTS]) -> usize {
+        let n = self.contacts.len().min(MAX_CONTACTS);
+        for (o, c) in out.iter_mut().zip(&self.contacts[..n]) {
+            *o = RailContact {
+                approach: c.approach + c.normal[0] * d[0] + c.normal[1] * d[1],
+                ..*c
+            };
+        }
+        n
+    }
+}
+
+/// Material and friction data of the contacts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactMaterial {
+    /// Shear modulus, Pa.
+    pub g: f64,
+    /// Poisson ratio, –.
+    pub nu: f64,
+    /// Coefficient of friction, –.
+    pub mu: f64,
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticRailSettings {
+    /// Time step for the damping rate `ḋ = (d − d_prev)/h`, s; `f64::INFINITY`
+    /// for the static problem.
+    pub h: f64,
+    /// Rolling speed `V` (m/s) converting the rail velocity into creepage.
+    pub v_roll: f64,
+    /// Inner tolerance on the force residual, N.
+    pub force_tol: f64,
+    /// Outer tolerance, relative change of normal and creep forces.
+    pub rel_tol: f64,
+    /// Iteration limits.
+    pub max_inner: usize,
+    /// Outer iteration limit.
+    pub max_outer: usize,
+}
+
+impl Default for ElasticRailSettings {
+    fn default() -> Self {
+        Self {
+            h: f64::INFINITY,
+            v_roll: 1.0,
+            force_tol: 1e-6,
+            rel_tol: 1e-9,
+            max_inner: 50,
+            max_outer: 50,
+        }
+    }
+}
+
+/// Result for one contact.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactResult {
+    /// Normal force on the wheel, N.
+    pub normal_force: f64,
+    /// Unit normal (rail → wheel), `(n_y, n_z)`.
+    pub normal: [f64; 2],
+    /// Creep forces on the wheel in the contact frame.
+    pub creep: CreepForces,
+    /// Semi-axes of the contact ellipse, m.
+    pub a: f64,
+    /// Lateral semi-axis, m.
+    pub b: f64,
+    /// Approach at equilibrium, m.
+    pub approach: f64,
+}
+
+/// Solution of the elastic-rail problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticRailSolution {
+    /// Rail displacement `(d_y, d_z)`, m.
+    pub displacement: [f64; 2],
+    /// Rail velocity `(ḋ_y, ḋ_z)`, m/s (zero for the static problem).
+    pub velocity: [f64; 2],
+    /// Number of contacts.
+    pub n_contacts: usize,
+    /// Per contact.
+    pub contacts: [ContactResult; MAX_CONTACTS],
+    /// Total force of the contacts on the wheel, `(F_y, F_z)` in the rail
+    /// cross-section, N (equal and opposite to the support force on the rail).
+    pub wheel_force: [f64; 2],
+    /// Inner iterations, summed over outer iterations.
+    pub inner_iterations: usize,
+    /// Outer iterations.
+    pub outer_iterations: usize,
+}
+
+/// Solves the equilibrium of a massless elastic rail under one wheel, starting
+/// from the previous displacement `d_prev` (m).
+pub fn solve(
+    support: &RailSupport,
+    material: &ContactMaterial,
+    geometry: &dyn RailContactGeometry,
+    law: &dyn CreepLaw,
+    d_prev: [f64; 2],
+    settings: &ElasticRailSettings,
+) -> Result<ElasticRailSolution, ElasticRailError> {
+    let p = |s: String| Err(ElasticRailError::Parameter(s));
+    if !(support.ky.is_finite() && support.ky > 0.0 && support.kz.is_finite() && support.kz > 0.0) {
+        return p(format!(
+            "support stiffnesses must be positive and finite, got ky = {} N/m, kz = {} N/m",
+            support.ky, support.kz
+        ));
+    }
+    if !(support.cy.is_finite() && support.cy >= 0.0 && support.cz.is_finite() && support.cz >= 0.0)
+    {
+        return p(format!(
+            "support damping must be non-negative and finite, got cy = {}, cz = {} N·s/m",
+            support.cy, support.cz
+        ));
+    }
+    if settings.h.is_nan() || settings.h <= 0.0 {
+        return p(format!(
+            "time step must be positive, got h = {} s",
+            settings.h
+        ));
+    }
+    if !(settings.v_roll.is_finite() && settings.v_roll > 0.0) {
+        return p(format!(
+            "rolling speed must be positive and finite, got {} m/s",
+            settings.v_roll
+        ));
+    }
+    if !d_prev.iter().all(|v| v.is_finite()) {
+        return p(format!("previous rail displacement not finite: {d_prev:?}"));
+    }
+    // Effective stiffness with the damper over the step: K + C/h, and the
+    // damper's memory term C/h·d_prev on the right-hand side.
+    let (ch_y, ch_z) = if settings.h.is_finite() {
+        (support.cy / settings.h, support.cz / settings.h)
+    } else {
+        (0.0, 0.0)
+    };
+    let keff = [support.ky + ch_y, support.kz + ch_z];
+    let rhs0 = [ch_y * d_prev[0], ch_z * d_prev[1]];
+
+    let mut d = d_prev;
+    let mut geo = [RailContact {
+        approach: 0.0,
+        normal: [0.0, 1.0],
+        hertz: HertzShape::with_modulus(1.0, 1.0, 1.0).map_err(|e| ElasticRailError::Geometry {
+            index: 0,
+            what: e.to_string(),
+        })?,
+        creepages: Creepages::default(),
+    }; MAX_CONTACTS];
+    // Lateral creep forces (along tᵢ) held fixed in the inner iterations.
+    let mut creep_t = [0.0; MAX_CONTACTS];
+    let mut creep = [CreepForces::default(); MAX_CONTACTS];
+    let mut normal = [0.0; MAX_CONTACTS];
+    let mut inner_total = 0;
+    let mut n_contacts = 0;
+    for outer in 1..=settings.max_outer {
+        // Inner: Newton on R(d) = Keff d − rhs0 + Σ Fᵢ(d) = 0.
+        let mut converged = false;
+        let mut residual = f64::INFINITY;
+        for _ in 0..settings.max_inner {
+            inner_total += 1;
+            n_contacts = geometry.contacts_at(d, &mut geo);
+            let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
+            let mut j = [[keff[0], 0.0], [0.0, keff[1]]];
+            for (i, c) in geo[..n_contacts].iter().enumerate() {
+                check_contact(i, c)?;
+                let nn = c
+                    .hertz
+                    .normal_force(c.approach)
+                    .map_err(|e| contact_err(i, e))?;
+                let kn = c.hertz.stiffness(c.approach);
+                let [ny, nz] = c.normal;
+                let t = [nz, -ny];
+                normal[i] = nn;
+                r[0] += nn * ny + creep_t[i] * t[0];
+                r[1] += nn * nz + creep_t[i] * t[1];
+                // dFᵢ/dd = kn·n nᵀ (δ = δ₀ + n·d).
+                j[0][0] += kn * ny * ny;
+                j[0][1] += kn * ny * nz;
+                j[1][0] += kn * nz * ny;
+                j[1][1] += kn * nz * nz;
+            }
+            residual = r[0].hypot(r[1]);
+            if residual <= settings.force_tol {
+                converged = true;
+                break;
+            }
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            let mut dd = [
+                -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
+                -(-j[1][0] * r[0] + j[0][0] * r[1]) / det,
+            ];
+            // Damped step: do not let an approach jump from positive far into
+            // separation (Hertz is stiff at contact, zero beyond): halve the step
+            // while the residual norm would grow.
+            let r_norm = residual;
+            let mut accepted = false;
+            for _ in 0..30 {
+                let trial = [d[0] + dd[0], d[1] + dd[1]];
+                let rt = residual_at(geometry, &mut geo, trial, keff, rhs0, &creep_t)?;
+                if rt < r_norm || rt <= settings.force_tol {
+                    d = trial;
+                    accepted = true;
+                    break;
+                }
+                dd = [0.5 * dd[0], 0.5 * dd[1]];
+            }
+            if !accepted {
+                break;
+            }
+        }
+        if !converged {
+            return Err(ElasticRailError::NoConvergence {
+                kind: "inner",
+                iterations: settings.max_inner,
+                residual,
+            });
+        }
+        // Outer: creep forces from the new normal forces and the rail velocity.
+        let vel = rail_velocity(d, d_prev, settings.h);
+        let mut change = 0.0_f64;
+        let mut scale = 0.0_f64;
+        for i in 0..n_contacts {
+            let c = &geo[i];
+            let [ny, nz] = c.normal;
+            let t = [nz, -ny];
+            let (f, _) = creep_force(i, c, normal[i], material, law, vel, t, settings.v_roll)?;
+            change = change.max((f.fy - creep[i].fy).abs().max((f.fx - creep[i].fx).abs()));
+            scale = scale.max(normal[i]);
+            creep[i] = f;
+            creep_t[i] = f.fy;
+        }
+        for item in creep.iter_mut().skip(n_contacts) {
+            *item = CreepForces::default();
+        }
+        // Converged when the creep forces did not change (relative to the load).
+        let rel = if scale > 0.0 { change / scale } else { 0.0 };
+        let settled = rel <= settings.rel_tol;
+        if settled || outer == settings.max_outer {
+            if !settled {
+                return Err(ElasticRailError::NoConvergence {
+                    kind: "outer",
+                    iterations: outer,
+                    residual: rel,
+                });
+            }
+            let mut contacts = [ContactResult::default(); MAX_CONTACTS];
+            let mut wheel_force = [0.0; 2];
+            for i in 0..n_contacts {
+                let c = &geo[i];
+                let [ny, nz] = c.normal;
+                let hc = c.hertz.contact(normal[i]).map_err(|e| contact_err(i, e))?;
+                contacts[i] = ContactResult {
+                    normal_force: normal[i],
+                    normal: c.normal,
+                    creep: creep[i],
+                    a: hc.a,
+                    b: hc.b,
+                    approach: c.approach,
+                };
+                wheel_force[0] += normal[i] * ny + creep[i].fy * nz;
+                wheel_force[1] += normal[i] * nz - creep[i].fy * ny;
+            }
+            return Ok(ElasticRailSolution {
+                displacement: d,
+                velocity: vel,
+                n_contacts,
+                contacts,
+                wheel_force,
+                inner_iterations: inner_total,
+                outer_iterations: outer,
+            });
+        }
+    }
+    Err(ElasticRailError::NoConvergence {
+        kind: "outer",
+        iterations: settings.max_outer,
+        residual: f64::NAN,
+    })
+}
+
+fn contact_err(index: usize, e: impl std::error::Error) -> ElasticRailError {
+    ElasticRailError::Contact {
+        index,
+        message: e.to_string(),
+    }
+}
+
+fn check_contact(i: usize, c: &RailContact) -> Result<(), ElasticRailError> {
+    let n2 = c.normal[0] * c.normal[0] + c.normal[1] * c.normal[1];
+    if (n2 - 1.0).abs() >= 1e-9 || n2.is_nan() {
+        return Err(ElasticRailError::Geometry {
+            index: i,
+            what: format!("normal {:?} is not a unit vector", c.normal),
+        });
+    }
+    if !c.approach.is_finite() {
+        return Err(ElasticRailError::Geometry {
+            index: i,
+            what: format!("approach is not finite ({})", c.approach),
+        });
+    }
+    Ok(())
+}
+
+fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
+    if h.is_finite() {
+        [(d[0] - d_prev[0]) / h, (d[1] - d_prev[1]) / h]
+    } else {
+        [0.0, 0.0]
+    }
+}
+
+/// Creep forces of contact `i` for normal force `nn`; the rail's velocity
+/// `vel` moves the rail's material point, `Δη = −(vel·t)/V`.
+#[allow(clippy::too_many_arguments)]
+fn creep_force(
+    i: usize,
+    c: &RailContact,
+    nn: f64,
+    material: &ContactMaterial,
+    law: &dyn CreepLaw,
+    vel: [f64; 2],
+    t: [f64; 2],
+    v_roll: f64,
+) -> Result<(CreepForces, f64), ElasticRailError> {
+    if nn <= 0.0 {
+        return Ok((CreepForces::default(), 0.0));
+    }
+    let hc = c.hertz.contact(nn).map_err(|e| contact_err(i, e))?;
+    let patch = ContactPatch {
+        a: hc.a,
+        b: hc.b,
+        g: material.g,
+        nu: material.nu,
+        mu: material.mu,
+        n: nn,
+    };
+    let cr = Creepages {
+        eta: c.creepages.eta - (vel[0] * t[0] + vel[1] * t[1]) / v_roll,
+        ..c.creepages
+    };
+    let f = law.forces(&patch, &cr).map_err(|e| contact_err(i, e))?;
+    Ok((f, hc.a))
+}
+
+/// Norm of the inner residual at displacement `d`.
+fn residual_at(
+    geometry: &dyn RailContactGeometry,
+    geo: &mut [RailContact; MAX_CONTACTS],
+    d: [f64; 2],
+    keff: [f64; 2],
+    rhs0: [f64; 2],
+    creep_t: &[f64; MAX_CONTACTS],
+) -> Result<f64, ElasticRailError> {
+    let n = geometry.contacts_at(d, geo);
+    let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
+    for (i, c) in geo[..n].iter().enumerate() {
+        check_contact(i, c)?;
+        let nn = c
+            .hertz
+            .normal_force(c.approach)
+            .map_err(|e| contact_err(i, e))?;
+        let [ny, nz] = c.normal;
+        r[0] += nn * ny + creep_t[i] * nz;
+        r[1] += nn * nz - creep_t[i] * ny;
+    }
+    Ok(r[0].hypot(r[1]))
+}
