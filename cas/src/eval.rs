@@ -90,9 +90,18 @@ impl Context {
                 Node::Add { constant, terms } => terms
                     .iter()
                     .fold(*constant, |acc, &(b, c)| acc + c * val[b.index()]),
-                Node::Mul { factors } => factors
-                    .iter()
-                    .fold(1.0, |acc, &(b, k)| acc * val[b.index()].powi(k)),
+                Node::Mul { factors } => {
+                    // numerator / denominator, as the generated code computes it
+                    let (mut num, mut den) = (1.0, 1.0);
+                    for &(b, k) in factors.iter() {
+                        if k > 0 {
+                            num *= val[b.index()].powi(k);
+                        } else {
+                            den *= val[b.index()].powi(k.saturating_neg());
+                        }
+                    }
+                    num / den
+                }
                 Node::Call(f, a) => f.apply(val[a.index()]),
                 Node::Atan2(y, x) => val[y.index()].atan2(val[x.index()]),
             };

@@ -146,9 +146,11 @@ impl Func {
 ///   `constant ≠ 0` or `c ≠ 1`. A *scaled term* `c·b` is an `Add` with `constant = 0` and one term;
 ///   negation is the scaled term with `c = −1`.
 /// * `Mul { factors }` is `Π bᵢ^kᵢ` with integer `kᵢ ≠ 0`: sorted by id, distinct bases, no base
-///   that is a `Num`, a `Mul` or a scaled term (numeric factors are pulled out into a scaled term
-///   around the product). Either ≥ 2 factors or one factor with `k ≠ 1`. Division is a negative
-///   exponent; integer powers are single-factor products.
+///   that is a `Mul` or a scaled term (numeric factors are pulled out into a scaled term around
+///   the product). A `Num` base occurs only as `v^k` with `v > 0`, `k < 0` and `c/v^|k|` not
+///   exactly representable for the coefficient `c` around the product (so `x/3` stays a
+///   division by 3 while `x/4 = 0.25·x`). Either ≥ 2 factors or one factor with `k ≠ 1`.
+///   Division is a negative exponent; integer powers are single-factor products.
 #[derive(Clone, Debug)]
 pub enum Node {
     /// A number.
@@ -573,6 +575,34 @@ impl Context {
     fn finish_sum(&mut self, constant: f64, mut terms: Vec<(ExprId, f64)>) -> ExprId {
         let mut constant = constant;
         collect_like(&mut terms);
+        // c·(product with numbers kept as factors, e.g. x·3⁻¹) may now fold exactly:
+        // 3·(x·3⁻¹) = x. Re-multiplying may merge terms again: a few rounds at most.
+        for _ in 0..4 {
+            if !terms
+                .iter()
+                .any(|&(b, c)| c != 1.0 && self.has_numeric_factor(b))
+            {
+                break;
+            }
+            let mut changed = false;
+            let old = std::mem::take(&mut terms);
+            for (b, c) in old {
+                if c != 1.0 && self.has_numeric_factor(b) {
+                    let cn = self.num(c);
+                    let p = self.mul(cn, b);
+                    if self.split_coeff(p) != (c, b) {
+                        changed = true;
+                        self.push_term(&mut constant, &mut terms, p, 1.0);
+                        continue;
+                    }
+                }
+                terms.push((b, c));
+            }
+            if !changed {
+                break;
+            }
+            collect_like(&mut terms);
+        }
         // sin²+cos² may produce new terms that merge with existing ones: repeat (each round
         // removes at least one term, so this terminates).
         while self.pythagoras(&mut constant, &mut terms) {
@@ -586,6 +616,16 @@ impl Context {
                 constant,
                 terms: terms.into_boxed_slice(),
             }),
+        }
+    }
+
+    /// A product with a number among its factors (kept because its reciprocal is inexact).
+    fn has_numeric_factor(&self, b: ExprId) -> bool {
+        match self.node(b) {
+            Node::Mul { factors } => factors
+                .iter()
+                .any(|&(f, _)| matches!(self.node(f), Node::Num(_))),
+            _ => false,
         }
     }
 
@@ -734,19 +774,34 @@ impl Context {
     pub fn product(&mut self, factors: &[(ExprId, i32)]) -> ExprId {
         let mut coeff = 1.0;
         let mut fs = Vec::with_capacity(factors.len() + 2);
+        let mut nums = Vec::new();
         for &(x, k) in factors {
-            self.push_factor(&mut coeff, &mut fs, x, k);
+            self.push_factor(&mut coeff, &mut fs, &mut nums, x, k);
         }
-        self.finish_product(coeff, fs)
+        self.finish_product(coeff, fs, nums)
     }
 
-    fn push_factor(&self, coeff: &mut f64, fs: &mut Vec<(ExprId, i32)>, x: ExprId, k: i32) {
+    /// Adds `x^k` to a product under construction: numeric coefficients with positive powers
+    /// go into `coeff`, with negative powers into `nums` (folded later only if exact),
+    /// products are flattened.
+    fn push_factor(
+        &self,
+        coeff: &mut f64,
+        fs: &mut Vec<(ExprId, i32)>,
+        nums: &mut Vec<(f64, i32)>,
+        x: ExprId,
+        k: i32,
+    ) {
         if k == 0 {
             return;
         }
         let (c, b) = self.split_coeff(x);
         if c != 1.0 {
-            *coeff *= c.powi(k);
+            if k > 0 {
+                *coeff *= c.powi(k);
+            } else {
+                nums.push((c, k));
+            }
         }
         if b == ONE {
             return;
@@ -759,7 +814,59 @@ impl Context {
         }
     }
 
-    fn finish_product(&mut self, coeff: f64, mut fs: Vec<(ExprId, i32)>) -> ExprId {
+    fn finish_product(
+        &mut self,
+        coeff: f64,
+        mut fs: Vec<(ExprId, i32)>,
+        mut nums: Vec<(f64, i32)>,
+    ) -> ExprId {
+        let mut coeff = coeff;
+        // Numeric bases kept from earlier products (inexact reciprocals) join the numbers.
+        fs.retain(|&(f, k)| match self.nodes[f.index()] {
+            Node::Num(v) => {
+                nums.push((v, k));
+                false
+            }
+            _ => true,
+        });
+        if !nums.is_empty() {
+            // Canonical sign: (−v)^k = (−1)^k·v^k.
+            for n in nums.iter_mut() {
+                if n.0 < 0.0 {
+                    n.0 = -n.0;
+                    if n.1 % 2 != 0 {
+                        coeff = -coeff;
+                    }
+                }
+            }
+            nums.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let mut merged: Vec<(f64, i32)> = Vec::with_capacity(nums.len());
+            for (v, k) in nums {
+                match merged.last_mut() {
+                    Some(last) if last.0.to_bits() == v.to_bits() => {
+                        last.1 = last.1.saturating_add(k)
+                    }
+                    _ => merged.push((v, k)),
+                }
+            }
+            // Positive powers fold (like all products of numbers); negative powers fold only
+            // when the quotient is exact, otherwise the number stays a factor `v^k` (so x/3
+            // is evaluated as a division, and 3·(x/3) = x).
+            for &(v, k) in merged.iter().filter(|n| n.1 > 0) {
+                coeff *= v.powi(k);
+            }
+            for &(v, k) in merged.iter().filter(|n| n.1 < 0) {
+                match exact_div_pow(coeff, v, k.unsigned_abs()) {
+                    Some(r) => coeff = r,
+                    None => {
+                        let id = self.num(v);
+                        if id != ONE {
+                            fs.push((id, k));
+                        }
+                    }
+                }
+            }
+        }
         if coeff == 0.0 {
             return ZERO;
         }
@@ -789,9 +896,10 @@ impl Context {
             let mut rest: Vec<(ExprId, i32)> = fs.into_iter().filter(|f| f.1 != 0).collect();
             let mut c = coeff;
             let mut more = Vec::new();
-            self.push_factor(&mut c, &mut more, u, k / 2);
+            let mut nums = Vec::new();
+            self.push_factor(&mut c, &mut more, &mut nums, u, k / 2);
             rest.extend(more);
-            return self.finish_product(c, rest);
+            return self.finish_product(c, rest, nums);
         }
         let base = self.mul_canonical(fs);
         if base == ONE {
@@ -1056,6 +1164,25 @@ impl Context {
     pub fn display(&self, id: ExprId) -> Display<'_> {
         Display { ctx: self, id }
     }
+}
+
+/// `c / vⁿ` if it is exactly representable (and finite, non-zero), else `None`. Each
+/// multiplication and the division are checked with a fused multiply-add: `fma(a, b, −p) = 0`
+/// iff `p = a·b` exactly.
+fn exact_div_pow(c: f64, v: f64, n: u32) -> Option<f64> {
+    if n > 64 {
+        return None;
+    }
+    let mut p = 1.0f64;
+    for _ in 0..n {
+        let np = p * v;
+        if !np.is_finite() || np == 0.0 || p.mul_add(v, -np) != 0.0 {
+            return None;
+        }
+        p = np;
+    }
+    let r = c / p;
+    (r.is_finite() && r != 0.0 && r.mul_add(p, -c) == 0.0).then_some(r)
 }
 
 /// Sorts terms by base, merges equal bases (adding coefficients) and drops zero coefficients.

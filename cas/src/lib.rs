@@ -21,9 +21,12 @@
 //!   Division is a product with exponent −1 (no separate node), an integer power is a
 //!   one-factor product, negation is the coefficient −1 (a "scaled term" `c·b` is a one-term
 //!   sum). Operands of sums and products are sorted by id, so commutative forms are equal nodes.
-//! * **Numbers** are `f64`. Folding is plain f64 arithmetic: exact whenever the result is
-//!   representable (integers, dyadic fractions such as 0.5, which is what model coefficients
-//!   and the derivatives of integer powers produce), otherwise correctly rounded per operation.
+//! * **Numbers** are `f64`. Sums and products of numbers fold in f64 (exact whenever the
+//!   result is representable: integers, dyadic fractions such as 0.5, which is what model
+//!   coefficients and derivatives of integer powers produce). Division by a number folds only
+//!   when the quotient is exact (checked with a fused multiply-add): `x/4 = 0.25·x`, but `x/3`
+//!   keeps the factor `3⁻¹`, is evaluated as a division, and `3·(x/3) = x`,
+//!   `x/3 + 2x/3 = x`; `m·l²/12` stays exact.
 //!   Functions of numbers are folded only when the result is finite (`ln(-1)` stays symbolic).
 //!   Non-finite values are never produced silently: [`Context::eval`], [`Program::eval`]
 //!   report them as [`CasError::NonFinite`].

@@ -78,6 +78,74 @@ fn constant_folding() {
 }
 
 #[test]
+fn division_by_numbers_folds_only_when_exact() {
+    let mut c = Context::new();
+    let (x, y, _) = xyz(&mut c);
+    let (three, four, twelve) = (c.num(3.0), c.num(4.0), c.num(12.0));
+    // exact: x/4 = 0.25·x
+    let q = c.div(x, four);
+    assert_eq!(q, c.scale(0.25, x));
+    // inexact: x/3 keeps the factor 3⁻¹ …
+    let t = c.div(x, three);
+    assert!(
+        matches!(c.node(t), Node::Mul { factors } if factors.len() == 2),
+        "{}",
+        c.display(t)
+    );
+    // … so that 3·(x/3) = x, x/3 + 2x/3 = x, (x/3)·(y/4)·12 = x·y
+    assert_eq!(c.mul(three, t), x);
+    let two_t = c.scale(2.0, t);
+    assert_eq!(c.add(t, two_t), x);
+    let q2 = c.div(y, four);
+    let p = c.mul_many(&[t, q2, twelve]);
+    assert_eq!(p, c.mul(x, y));
+    // 1/3 + 2/3 = 1 and 6/3 = 2 fold
+    let third = c.recip(three);
+    let two = c.num(2.0);
+    let two_thirds = c.div(two, three);
+    assert_eq!(c.add(third, two_thirds), ONE);
+    let six = c.num(6.0);
+    let q6 = c.div(six, three);
+    assert_eq!(c.as_num(q6), Some(2.0));
+    // division by a negative number: canonical positive base, sign in the coefficient
+    let m3 = c.num(-3.0);
+    let d = c.div(x, m3);
+    assert_eq!(d, c.neg(t));
+    // evaluated as a division, bit-exact: x/3 at x = 1 is the correctly rounded 1/3
+    let v = c
+        .eval(
+            &[t],
+            &Values {
+                q: &[1.0],
+                ..Default::default()
+            },
+        )
+        .unwrap()[0];
+    assert_eq!(v, 1.0 / 3.0);
+    let prog = Program::compile(&c, &[t]);
+    assert_eq!(
+        prog.eval(&Values {
+            q: &[1.0],
+            ..Default::default()
+        })
+        .unwrap()[0],
+        1.0 / 3.0
+    );
+    // division by zero is kept symbolic and reported on evaluation
+    let z = c.div(x, ZERO);
+    assert!(
+        c.eval(
+            &[z],
+            &Values {
+                q: &[1.0],
+                ..Default::default()
+            }
+        )
+        .is_err()
+    );
+}
+
+#[test]
 fn zero_one_identities() {
     let mut c = Context::new();
     let (x, _, _) = xyz(&mut c);

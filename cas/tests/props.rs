@@ -29,6 +29,8 @@ enum T {
     DivSafe(Box<T>, Box<T>),
     /// a^n, n in 0..=3
     Pow(Box<T>, i32),
+    /// a / k for a number k
+    DivNum(Box<T>, f64),
     /// (1 + b²)^(−n), n in 1..=2
     PowNegSafe(Box<T>, i32),
     Sin(Box<T>),
@@ -94,6 +96,11 @@ fn tree() -> impl Strategy<Value = T> {
                 .prop_map(move |(c, x)| T::Scale(c, b(x))),
             (inner.clone(), inner.clone()).prop_map(move |(x, y)| T::DivSafe(b(x), b(y))),
             (inner.clone(), 0i32..=3).prop_map(move |(x, n)| T::Pow(b(x), n)),
+            (
+                inner.clone(),
+                prop::sample::select(vec![3.0, -4.0, 0.1, 12.0, 7.0])
+            )
+                .prop_map(move |(x, k)| T::DivNum(b(x), k)),
             (inner.clone(), 1i32..=2).prop_map(move |(x, n)| T::PowNegSafe(b(x), n)),
             inner.clone().prop_map(move |x| T::Sin(b(x))),
             inner.clone().prop_map(move |x| T::Cos(b(x))),
@@ -147,6 +154,10 @@ fn plain(t: &T, s: &[f64; 5]) -> (f64, f64) {
             let (x, m) = plain(a, s);
             let v = x.powi(*n);
             (v, *n as f64 * m.powi(*n) + v.abs())
+        }
+        T::DivNum(a, k) => {
+            let (x, m) = plain(a, s);
+            (x / k, m / k.abs())
         }
         T::PowNegSafe(b, n) => {
             let (d, md) = safe(b);
@@ -239,6 +250,11 @@ fn build(c: &mut Context, t: &T) -> ExprId {
         T::Pow(a, n) => {
             let x = build(c, a);
             c.powi(x, *n)
+        }
+        T::DivNum(a, k) => {
+            let x = build(c, a);
+            let kn = c.num(*k);
+            c.div(x, kn)
         }
         T::PowNegSafe(b, n) => {
             let d = safe(c, b);
@@ -405,6 +421,7 @@ fn mirror(t: &T) -> T {
         T::Scale(c, a) => T::Scale(*c, m(a)),
         T::DivSafe(a, b) => T::DivSafe(m(a), m(b)),
         T::Pow(a, n) => T::Pow(m(a), *n),
+        T::DivNum(a, k) => T::DivNum(m(a), *k),
         T::PowNegSafe(a, n) => T::PowNegSafe(m(a), *n),
         T::Sin(a) => T::Sin(m(a)),
         T::Cos(a) => T::Cos(m(a)),
@@ -432,6 +449,7 @@ fn has_kink_near(t: &T, s: &[f64; 5], var: usize, h: f64) -> bool {
         T::Neg(a)
         | T::Scale(_, a)
         | T::Pow(a, _)
+        | T::DivNum(a, _)
         | T::PowNegSafe(a, _)
         | T::Sin(a)
         | T::Cos(a)
