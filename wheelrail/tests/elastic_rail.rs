@@ -105,8 +105,8 @@ fn lateral_equilibrium_balances() {
     .unwrap();
     // Balance to the outer tolerance (creep forces settled to 1e-9 of the load).
     let k = [support.ky, support.kz];
-    for i in 0..2 {
-        let bal = k[i] * s.displacement[i] + s.wheel_force[i];
+    for (i, ki) in k.iter().enumerate() {
+        let bal = ki * s.displacement[i] + s.wheel_force[i];
         assert!(
             bal.abs() < 1e-8 * s.contacts[0].normal_force,
             "direction {i}: {bal}"
