@@ -75,8 +75,10 @@
 //!   same coefficient `c`, `k, m ≥ 2`, and the same remaining monomial
 //!   `sin(u)^(k−2)·P = cos(u)^(m−2)·P'` are replaced by `c·(that remainder)`, repeatedly (the
 //!   result may merge with other terms). This is what products of elementary rotation
-//!   matrices create: `R_z(a)ᵀR_z(a)` simplifies to the identity, `m·l²·sin²q + m·l²·cos²q` to
-//!   `m·l²`.
+//!   matrices create: `R_z(a)ᵀR_z(a)` and `RᵀR` for `R = R_z(a)R_x(b)` simplify to the
+//!   identity, `m·l²·sin²q + m·l²·cos²q` to `m·l²`. When the entries are sums (three or more
+//!   rotations), `RᵀR` contains squares of sums and reduces to the identity only after
+//!   [`Context::expand`].
 //!
 //! It does **not**: expand products of sums, factor, find common denominators, apply angle
 //! addition formulas, combine `c₁·sin²u·P + c₂·cos²u·P` with `c₁ ≠ c₂`, recognise
@@ -87,8 +89,8 @@
 //!
 //! [`Context::diff`] differentiates with respect to a symbol, memoized per variable for the
 //! life of the context ([`Context::jacobian`] for many at once; [`Context::clear_diff_cache`]
-//! frees the memo). [`Context::subs`] and
-//! [`Substitution`] replace symbols by expressions (memoized). [`Context::eval`] is the
+//! frees the memo). [`Context::subs`] and [`Substitution`] replace symbols by expressions
+//! (memoized). [`Context::eval`] is the
 //! reference interpreter, with symbol values per kind in [`Values`].
 //!
 //! ## Kinematics helpers
@@ -112,6 +114,10 @@
 //! the temporaries they share through a scratch array (slots reused when dead);
 //! [`SplitProgram::eval`] checks a split by running each chunk in isolation.
 //! [`Program::sin_cos_pairs`] lists sin/cos of the same argument for `sin_cos` fusion.
+//!
+//! Everything is deterministic: the same sequence of constructor calls gives the same ids and
+//! the same program, instruction for instruction (no dependence on hash-map iteration order),
+//! so generated source can be cached by content hash.
 
 mod calculus;
 mod eval;
