@@ -853,6 +853,45 @@ fn pendulum_large_amplitude_period_constraint_and_tension() {
 }
 
 #[test]
+fn consistent_multipliers_equal_the_rod_tension_of_the_state() {
+    // With `consistent_multipliers` λ comes from the acceleration-level
+    // equations at each accepted state, so it must equal the tension
+    // m (g cos θ + |v|²/l) of that state up to the central-difference γ
+    // (~1e-7 relative) and the O(tol) velocity-constraint residual G v.
+    let theta0 = PI / 3.0;
+    let mut p = Pendulum {
+        m: 3.0,
+        l: 1.2,
+        g: 9.81,
+    };
+    let (m, l, g) = (p.m, p.l, p.g);
+    let q0 = [l * theta0.sin(), -l * theta0.cos()];
+    let settings = ParkSettings {
+        consistent_multipliers: true,
+        ..ParkSettings::with_tolerances(1e-8, 1e-8)
+    };
+    let mut worst = 0.0_f64;
+    let mut worst_accel = 0.0_f64;
+    let st = Park::new(settings)
+        .run(&mut p, 0.0, &q0, &[0.0, 0.0], 3.0, |s| {
+            let (x, y, vx, vy) = (s.q[0], s.q[1], s.v[0], s.v[1]);
+            let tension = m * (g * (-y / l) + (vx * vx + vy * vy) / l);
+            worst = worst.max((-2.0 * l * s.lambda[0] - tension).abs());
+            // Newton's law for the mass: m a = (0, −m g) − T (x, y)/l.
+            let ax = -tension * x / (l * m);
+            let ay = -g - tension * y / (l * m);
+            worst_accel = worst_accel
+                .max((s.accel[0] - ax).abs())
+                .max((s.accel[1] - ay).abs());
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+    println!("consistent multipliers: tension {worst:e} N, accel {worst_accel:e}, {st:?}");
+    assert!(worst < 1e-6 * m * g, "tension error {worst}");
+    assert!(worst_accel < 1e-6 * g, "acceleration error {worst_accel}");
+}
+
+#[test]
 fn pendulum_multiplier_converges_with_order_two_at_fixed_step() {
     let theta0 = PI / 3.0;
     let worst = |h: f64| {
@@ -1017,7 +1056,11 @@ fn step_loops_do_not_allocate() {
                     l: 1.0,
                     g: 9.81,
                 };
-                Park::new(ParkSettings::fixed(1e-3))
+                let settings = ParkSettings {
+                    consistent_multipliers: true,
+                    ..ParkSettings::fixed(1e-3)
+                };
+                Park::new(settings)
                     .run(&mut p, 0.0, &[0.6, -0.8], &[0.0, 0.0], t_end, |_| {
                         ControlFlow::Continue(())
                     })

@@ -51,11 +51,6 @@ impl DenseLu {
         self.valid
     }
 
-    /// Mark the stored factorization as unusable.
-    pub(crate) fn invalidate(&mut self) {
-        self.valid = false;
-    }
-
     /// The matrix to be factorized; fill it, then call [`DenseLu::factorize`].
     pub(crate) fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
         self.valid = false;

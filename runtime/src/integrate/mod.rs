@@ -120,6 +120,11 @@ pub(crate) fn check_run_arguments(
     v0: &[f64],
     t_end: f64,
 ) -> Result<(), SimError> {
+    if n == 0 {
+        return Err(SimError::Other(
+            "the system has no degrees of freedom (dof() = 0)".into(),
+        ));
+    }
     if q0.len() != n || v0.len() != n {
         return Err(SimError::Other(format!(
             "initial state has {} coordinates and {} velocities, the system has {n} degrees of freedom",

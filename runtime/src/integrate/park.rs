@@ -36,7 +36,7 @@
 //! factorized by LU and reused across iterations and steps (modified Newton);
 //! it is refactorized when β changes by more than 20 %, and the Jacobians
 //! ∂f/∂q, ∂f/∂q̇ (analytic from
-//! [`MechanicalSystem::force_jacobian`](crate::MechanicalSystem::force_jacobian)
+//! [`MechanicalSystem::force_jacobian`]
 //! or finite differences of `dynamics`) are re-evaluated when the iterations
 //! converge slowly or fail. The Newton stopping test is Hairer & Wanner's
 //! (Solving ODEs II, Sect. IV.8): with the contraction rate θ and
@@ -82,7 +82,9 @@
 //! leaves an error ~h·|q'''|·|Δh/h| in them (the truncation error of v depends
 //! on the step and D divides its change by h), a known property of BDF-type
 //! methods on index-3 systems (Brenan, Campbell & Petzold 1996, Sect. 3.2).
-//! For accurate constraint forces use a fixed step or tighter tolerances.
+//! For accurate constraint forces set
+//! [`ParkSettings::consistent_multipliers`]: the reported a and λ are then
+//! recomputed from the acceleration-level equations at each accepted state.
 //!
 //! # Consistent initial conditions (constrained systems)
 //!
@@ -111,7 +113,7 @@ pub enum JacobianKind {
     /// Central differences of `dynamics` (2n + 2n extra evaluations),
     /// increment ε^(1/3)·max(|x|, 1).
     CentralDifference,
-    /// [`MechanicalSystem::force_jacobian`](crate::MechanicalSystem::force_jacobian);
+    /// [`MechanicalSystem::force_jacobian`];
     /// falls back to forward differences when the system returns `false`.
     Analytic,
 }
@@ -143,6 +145,14 @@ pub struct ParkSettings {
     /// Newton stopping tolerance κ in the weighted norm (units of the error
     /// tolerance); `None` uses max(10ε/rtol, min(0.03, √rtol)).
     pub newton_tol: Option<f64>,
+    /// Constrained systems: report accelerations and multipliers recomputed
+    /// after every accepted step from the acceleration-level equations
+    /// `M a − Gᵀλ = f`, `G a = −γ` at the accepted (t, q, v), instead of
+    /// Park's a = D(D q) and its λ, which carry O(h·Δh/h) errors after
+    /// step-size changes (module docs). Costs one `dynamics` evaluation, three
+    /// constraint evaluations and one LU factorization of size n + nc per
+    /// step. The integration itself is unchanged.
+    pub consistent_multipliers: bool,
 }
 
 impl Default for ParkSettings {
@@ -157,6 +167,7 @@ impl Default for ParkSettings {
             fixed_step: false,
             max_newton_iterations: 8,
             newton_tol: None,
+            consistent_multipliers: false,
         }
     }
 }
@@ -258,6 +269,7 @@ struct StepCoefficients {
 }
 
 /// Workspaces sized for one system (n coordinates, nc constraints).
+#[derive(Debug)]
 struct Work {
     n: usize,
     nc: usize,
@@ -283,6 +295,10 @@ struct Work {
     constrained: Vec<bool>,
     // Linear algebra.
     lu: DenseLu,
+    /// LU workspace of the acceleration-level (KKT) system.
+    lu_kkt: DenseLu,
+    gamma: DVector<f64>,
+    gp: DVector<f64>,
     rhs: DVector<f64>,
     gtl: DVector<f64>,
     // History, index 0 = most recent accepted point.
@@ -329,6 +345,9 @@ impl Work {
             analytic_ok: true,
             constrained: vec![false; n],
             lu: DenseLu::new(n + nc),
+            lu_kkt: DenseLu::new(n + nc),
+            gamma: DVector::zeros(nc),
+            gp: DVector::zeros(nc),
             rhs: DVector::zeros(n + nc),
             gtl: v(),
             ht: [0.0; 4],
@@ -392,7 +411,6 @@ impl Work {
     ) -> Result<(), SimError> {
         let (n, nc) = (self.n, self.nc);
         self.eval_dynamics(system, t, st)?;
-        let mut gamma = DVector::zeros(nc);
         if nc > 0 {
             // φ(s) = g(q + s v, t + s); φ''(0) = γ. Step in time units chosen
             // so that s·|v| stays ~1e-4 of the coordinate scale; the central
@@ -400,32 +418,44 @@ impl Work {
             let qn = self.q.amax().max(1.0);
             let vn = self.v.amax().max(1e-12);
             let s = (1e-4 * qn / vn).min(1e-3);
-            let mut gp = DVector::zeros(nc);
-            let q0 = self.q.clone();
-            self.x_pert.copy_from(&q0);
-            self.x_pert.axpy(s, &self.v, 1.0);
-            let xp = self.x_pert.clone();
-            self.eval_constraints(system, t + s, &xp)?;
-            gp.copy_from(&self.gval);
-            self.x_pert.copy_from(&q0);
-            self.x_pert.axpy(-s, &self.v, 1.0);
-            let xm = self.x_pert.clone();
-            self.eval_constraints(system, t - s, &xm)?;
-            gamma.copy_from(&self.gval);
-            self.eval_constraints(system, t, &q0)?;
+            for (sign, out) in [(1.0, &mut self.gp), (-1.0, &mut self.gamma)] {
+                self.x_pert.copy_from(&self.q);
+                self.x_pert.axpy(sign * s, &self.v, 1.0);
+                system.constraints(
+                    t + sign * s,
+                    self.x_pert.as_slice(),
+                    &mut self.gval,
+                    &mut self.gjac,
+                )?;
+                check_finite(t, "constraint residual g", self.gval.as_slice())?;
+                out.copy_from(&self.gval);
+            }
+            system.constraints(t, self.q.as_slice(), &mut self.gval, &mut self.gjac)?;
+            check_finite(t, "constraint residual g", self.gval.as_slice())?;
+            check_finite(t, "constraint Jacobian G", self.gjac.as_slice())?;
             for k in 0..nc {
-                gamma[k] = (gp[k] - 2.0 * self.gval[k] + gamma[k]) / (s * s);
+                self.gamma[k] = (self.gp[k] - 2.0 * self.gval[k] + self.gamma[k]) / (s * s);
             }
         }
-        let m = self.lu.matrix_mut();
-        m.fill(0.0);
-        m.view_mut((0, 0), (n, n)).copy_from(&self.mass);
-        if nc > 0 {
-            m.view_mut((n, 0), (nc, n)).copy_from(&self.gjac);
-            m.view_mut((0, n), (n, nc))
-                .copy_from(&(-self.gjac.transpose()));
+        // KKT system [[M, −Gᵀ], [G, 0]] (a, λ) = (f, −γ), in its own LU
+        // workspace so the iteration matrix survives.
+        let m = self.lu_kkt.matrix_mut();
+        for j in 0..n {
+            for i in 0..n {
+                m[(i, j)] = self.mass[(i, j)];
+            }
         }
-        if self.lu.factorize().is_err() {
+        for k in 0..nc {
+            for j in 0..n {
+                let gkj = self.gjac[(k, j)];
+                m[(n + k, j)] = gkj;
+                m[(j, n + k)] = -gkj;
+            }
+            for l in 0..nc {
+                m[(n + k, n + l)] = 0.0;
+            }
+        }
+        if self.lu_kkt.factorize().is_err() {
             return Err(SimError::Diverged {
                 t,
                 reason: "cannot solve for the accelerations: mass matrix singular or constraint \
@@ -435,10 +465,9 @@ impl Work {
         }
         self.rhs.rows_mut(0, n).copy_from(&self.force);
         for k in 0..nc {
-            self.rhs[n + k] = -gamma[k];
+            self.rhs[n + k] = -self.gamma[k];
         }
-        self.lu.solve_in_place(&mut self.rhs);
-        self.lu.invalidate();
+        self.lu_kkt.solve_in_place(&mut self.rhs);
         self.a.copy_from(&self.rhs.rows(0, n));
         self.lam.copy_from(&self.rhs.rows(n, nc));
         check_finite(t, "acceleration q̈", self.a.as_slice())?;
@@ -975,6 +1004,7 @@ fn bdf_weights(s: &[f64], c: &mut [f64]) {
 
 /// Park's implicit integrator with its workspaces (reusable across runs of
 /// systems of the same size without reallocating).
+#[derive(Debug)]
 pub struct Park {
     settings: ParkSettings,
     work: Work,
@@ -1035,6 +1065,7 @@ impl Park {
         w.analytic_ok = true;
         w.constrained.fill(false);
         w.lu.resize(n + nc);
+        w.lu_kkt.resize(n + nc);
         let mut st = IntegrationStats::new(t0, n, nc);
 
         // Consistent initial state, accelerations and multipliers.
@@ -1235,6 +1266,14 @@ impl Park {
             // Accept.
             w.push_history(t_new);
             t = t_new;
+            if s.consistent_multipliers && nc > 0 {
+                // w.q, w.v hold the accepted state; replace the reported
+                // (and only reported: ha is used by the start-up predictor
+                // alone) accelerations and multipliers.
+                w.consistent_acceleration(system, t, &mut st)?;
+                w.ha[0].copy_from(&w.a);
+                w.lambda.copy_from(&w.lam);
+            }
             st.steps += 1;
             system.accept_step(t, w.hq[0].as_slice(), w.hv[0].as_slice());
             if report(w, &mut observer, t, hs) {
