@@ -5,7 +5,7 @@ use std::fmt;
 use std::ops::Range;
 
 use crate::eval::{CasError, Values};
-use crate::graph::{Context, ExprId, Func, FxMap, Node, Symbol};
+use crate::graph::{Context, ExprId, Func, FxBuild, FxMap, Node, Symbol};
 
 /// An instruction operand: a temporary (the result of instruction `k`), a symbol (an input), or
 /// a constant.
@@ -173,11 +173,11 @@ struct Builder {
 }
 
 impl Builder {
-    fn new(share: bool) -> Self {
+    fn new(share: bool, capacity: usize) -> Self {
         Builder {
-            instrs: Vec::new(),
+            instrs: Vec::with_capacity(capacity),
             share,
-            vn: FxMap::default(),
+            vn: FxMap::with_capacity_and_hasher(if share { capacity } else { 0 }, FxBuild),
             pows: FxMap::default(),
         }
     }
@@ -389,7 +389,8 @@ impl Program {
     /// Common-subexpression elimination of `outputs` (all together) into a program.
     pub fn compile(ctx: &Context, outputs: &[ExprId]) -> Program {
         let order = ctx.reachable(outputs);
-        let mut b = Builder::new(true);
+        // about 1.5 instructions per node in practice (binary chains of n-ary nodes)
+        let mut b = Builder::new(true, order.len() + order.len() / 2);
         let size = order.last().map_or(0, |l| l.index() + 1);
         let mut ops: Vec<Operand> = vec![Operand::Const(0.0); size];
         for id in order {
@@ -699,7 +700,7 @@ impl Context {
         let order = self.reachable(roots);
         let size = order.last().map_or(0, |l| l.index() + 1);
         let mut tree: Vec<OpCounts> = vec![OpCounts::default(); size];
-        let mut b = Builder::new(false);
+        let mut b = Builder::new(false, 16);
         for id in order {
             let node = self.node(id);
             b.instrs.clear();
