@@ -1,6 +1,6 @@
 //! Differentiation (memoized per variable) and substitution (memoized per substitution).
 
-use crate::graph::{Context, ExprId, Func, FxMap, Node, ONE, Symbol, ZERO};
+use crate::graph::{Context, ExprId, Func, FxMap, Node, ONE, Symbol, ZERO, symbol_bit};
 
 const UNKNOWN: u32 = u32::MAX;
 const PENDING: u32 = u32::MAX - 1;
@@ -45,16 +45,27 @@ impl Context {
         if cache[e.index()] < PENDING {
             return ExprId(cache[e.index()]);
         }
-        // Collect the not-yet-differentiated part of the DAG below e.
+        // Collect the not-yet-differentiated part of the DAG below e; subtrees whose
+        // dependency summary excludes s have derivative 0 and are not entered.
+        let bit = symbol_bit(s);
+        if self.deps[e.index()] & bit == 0 {
+            cache[e.index()] = ZERO.0;
+            return ZERO;
+        }
         let mut order = Vec::new();
         let mut stack = vec![e];
         cache[e.index()] = PENDING;
         while let Some(id) = stack.pop() {
             order.push(id);
+            let deps = &self.deps;
             self.nodes[id.index()].for_each_child(|c| {
                 if cache[c.index()] == UNKNOWN {
-                    cache[c.index()] = PENDING;
-                    stack.push(c);
+                    if deps[c.index()] & bit == 0 {
+                        cache[c.index()] = ZERO.0;
+                    } else {
+                        cache[c.index()] = PENDING;
+                        stack.push(c);
+                    }
                 }
             });
         }

@@ -323,6 +323,20 @@ pub(crate) type FxMap<K, V> = std::collections::HashMap<K, V, FxBuild>;
 
 const EMPTY: u32 = u32::MAX;
 
+/// The dependency bit of a symbol: coordinates use bits 0–31 (index mod 32), velocities bits
+/// 32–55 (index mod 24), parameters, inputs and time share bits 56–63. Symbols sharing a bit
+/// only make the independence test less sharp, never wrong.
+pub(crate) fn symbol_bit(s: Symbol) -> u64 {
+    let b = match s.kind {
+        SymbolKind::Coordinate => s.index % 32,
+        SymbolKind::Velocity => 32 + s.index % 24,
+        SymbolKind::Parameter => 56 + s.index % 4,
+        SymbolKind::Input => 60 + s.index % 3,
+        SymbolKind::Time => 63,
+    };
+    1u64 << b
+}
+
 /// Normalizes a number for storage: `-0.0` becomes `0.0`.
 fn norm(v: f64) -> f64 {
     if v == 0.0 { 0.0 } else { v }
@@ -333,6 +347,9 @@ fn norm(v: f64) -> f64 {
 pub struct Context {
     pub(crate) nodes: Vec<Node>,
     hashes: Vec<u64>,
+    /// Per node: a 64-bit summary of the symbols it depends on (see [`symbol_bit`]); a clear
+    /// bit proves independence, so differentiation skips such subtrees without visiting them.
+    pub(crate) deps: Vec<u64>,
     table: Vec<u32>,
     /// Per differentiation variable: derivative of node `i` at index `i` (`EMPTY` = unknown).
     pub(crate) diff_cache: FxMap<Symbol, Vec<u32>>,
@@ -361,6 +378,7 @@ impl Context {
         let mut c = Context {
             nodes: Vec::new(),
             hashes: Vec::new(),
+            deps: Vec::new(),
             table: vec![EMPTY; 64],
             diff_cache: Default::default(),
         };
@@ -418,6 +436,12 @@ impl Context {
                     .ok()
                     .filter(|&id| id < EMPTY)
                     .expect("railmbs-cas: more than 2^32-1 expression nodes");
+                let mut d = 0u64;
+                match &node {
+                    Node::Sym(s) => d = symbol_bit(*s),
+                    other => other.for_each_child(|c| d |= self.deps[c.index()]),
+                }
+                self.deps.push(d);
                 self.nodes.push(node);
                 self.hashes.push(h);
                 self.table[i] = id;
