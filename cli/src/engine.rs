@@ -1,7 +1,9 @@
 //! Choosing the equations-of-motion engine for a model.
 
+use railmbs_codegen::{BuiltPlugin, GenerateOptions};
 use railmbs_models::Model;
-use railmbs_runtime::{Equations, NumericEquations};
+use railmbs_runtime::plugin::ABI_VERSION;
+use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::path::Path;
 
 /// Which engine computes the equations of motion.
@@ -13,7 +15,17 @@ pub enum Engine {
     Symbolic,
 }
 
-/// Builds the engine for `model`.
+/// Generates and compiles (through the plugin cache) the plugin of `model`.
+pub fn build_symbolic(model: &Model) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
+    Ok(railmbs_codegen::build_plugin(
+        model,
+        &GenerateOptions::new(ABI_VERSION),
+        None,
+    )?)
+}
+
+/// Builds the engine for `model`. The symbolic engine loads `plugin` (checked
+/// against the model) or builds the model's plugin through the cache.
 pub fn build_engine(
     model: &Model,
     engine: Engine,
@@ -22,10 +34,12 @@ pub fn build_engine(
     match engine {
         Engine::Numeric => Ok(Box::new(NumericEquations::new(model))),
         Engine::Symbolic => {
-            let _ = plugin;
-            Err("the symbolic engine (compiled plugins, `umgen`) is not part of this build yet: \
-                 it is being built under the symbolic-equations issue; use --engine numeric"
-                .into())
+            let path = match plugin {
+                Some(p) => p.to_path_buf(),
+                None => build_symbolic(model)?.path,
+            };
+            let plugin = Plugin::load_for(&path, model)?;
+            Ok(Box::new(PluginEquations::new(plugin)))
         }
     }
 }

@@ -8,3 +8,4 @@ pub mod conicity;
 pub mod creep;
 pub mod engine;
 pub mod run;
+pub mod umgen;

@@ -1,1 +1,139 @@
-//! placeholder
+//! # railmbs-codegen
+//!
+//! The symbolic path: from a validated [`Model`] to the equations of motion as
+//! expressions ([`derive`], with the `cas` crate), to optimized straight-line
+//! Rust ([`emit`]: common-subexpression elimination over all outputs, split into
+//! functions of bounded size), to a compiled, cached `cdylib` plugin
+//! ([`build_plugin`], with `build-support`). The `umgen` binary (crate `cli`)
+//! drives it; `railmbs_runtime::plugin` loads the result.
+//!
+//! Identifiers stay symbols (runtime inputs of the plugin) unless fixed with
+//! [`GenerateOptions::fixed`].
+
+pub mod derive;
+pub mod emit;
+
+pub use derive::{derive, DeriveOptions, Derived};
+pub use emit::{EmitStats, PluginHeader};
+
+use railmbs_build_support::{BuildError, BuildOptions};
+use railmbs_models::Model;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// Options of code generation.
+#[derive(Debug, Clone)]
+pub struct GenerateOptions {
+    /// Names of identifiers to fix at their default values (constant-folded).
+    pub fixed: Vec<String>,
+    /// Largest number of instructions per generated function (rustc's time is
+    /// superlinear in function size; ~500–1000 lines keep it near-linear).
+    pub max_instructions_per_function: usize,
+    /// ABI version to write into the plugin (the loader's).
+    pub abi_version: u32,
+}
+
+impl GenerateOptions {
+    /// Defaults for the given ABI version.
+    pub fn new(abi_version: u32) -> Self {
+        Self {
+            fixed: Vec::new(),
+            max_instructions_per_function: 600,
+            abi_version,
+        }
+    }
+}
+
+/// Errors of code generation and compilation.
+#[derive(Debug, thiserror::Error)]
+pub enum CodegenError {
+    #[error("model \"{model}\": --fixed names no identifier \"{name}\"")]
+    UnknownFixed { model: String, name: String },
+    #[error(transparent)]
+    Build(#[from] BuildError),
+}
+
+/// Generated source and what it took.
+#[derive(Debug, Clone)]
+pub struct Generated {
+    pub source: String,
+    pub stats: EmitStats,
+    /// Symbolic derivation time.
+    pub derive_time: Duration,
+    /// CSE, splitting and source emission time.
+    pub emit_time: Duration,
+    pub model_hash: String,
+}
+
+/// Derives the equations of `model` and emits the plugin source.
+pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, CodegenError> {
+    let defaults = model.default_parameter_values();
+    let mut fixed_idx = Vec::new();
+    for name in &opts.fixed {
+        let i = model
+            .parameter_index(name)
+            .ok_or_else(|| CodegenError::UnknownFixed {
+                model: model.name.clone(),
+                name: name.clone(),
+            })?;
+        fixed_idx.push(i);
+    }
+    let start = Instant::now();
+    let derived = derive(
+        model,
+        &DeriveOptions {
+            fixed: fixed_idx.clone(),
+            defaults: defaults.clone(),
+        },
+    );
+    let derive_time = start.elapsed();
+    let start = Instant::now();
+    let model_hash = model.structural_hash();
+    let header = PluginHeader {
+        abi_version: opts.abi_version,
+        model_name: &model.name,
+        model_hash: &model_hash,
+        coordinate_names: model.coordinates.iter().map(|c| c.name.clone()).collect(),
+        parameter_names: model.parameters.iter().map(|p| p.name.clone()).collect(),
+        fixed: fixed_idx.iter().map(|&i| (i, defaults[i])).collect(),
+    };
+    let (source, stats) = emit::emit(&derived, &header, opts.max_instructions_per_function);
+    Ok(Generated {
+        source,
+        stats,
+        derive_time,
+        emit_time: start.elapsed(),
+        model_hash,
+    })
+}
+
+/// A compiled plugin.
+#[derive(Debug, Clone)]
+pub struct BuiltPlugin {
+    pub path: PathBuf,
+    pub generated: Generated,
+    /// `None` on a cache hit.
+    pub compile_time: Option<Duration>,
+    pub cache_hit: bool,
+}
+
+/// Generates and compiles the plugin of `model` through the cache
+/// (`cache_dir`, else `RAILMBS_CACHE_DIR`, else the platform cache directory).
+pub fn build_plugin(
+    model: &Model,
+    opts: &GenerateOptions,
+    cache_dir: Option<PathBuf>,
+) -> Result<BuiltPlugin, CodegenError> {
+    let generated = generate(model, opts)?;
+    let mut build = BuildOptions::new(opts.abi_version);
+    if let Some(dir) = cache_dir {
+        build = build.with_cache_dir(dir);
+    }
+    let out = railmbs_build_support::build_plugin(&generated.source, &build)?;
+    Ok(BuiltPlugin {
+        path: out.path,
+        compile_time: out.compile_time,
+        cache_hit: out.cache_hit,
+        generated,
+    })
+}

@@ -10,10 +10,12 @@ pub mod forces;
 pub mod integrate;
 pub mod model_system;
 pub mod numeric;
+pub mod plugin;
 pub mod simulate;
 pub mod system;
 
 pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
 pub use model_system::ModelSystem;
 pub use numeric::NumericEquations;
+pub use plugin::{Plugin, PluginEquations, PluginError};
 pub use system::{MechanicalSystem, SimError};

@@ -124,3 +124,28 @@ pub fn numeric_engine(model: &Model) -> NumericEquations {
     e.set_parameters(&model.default_parameter_values()).unwrap();
     e
 }
+
+/// Builds (through the cache under the target directory) and loads the
+/// symbolic plugin of `model`; built once per test process and model.
+pub fn symbolic_engine(model: &Model) -> railmbs_runtime::PluginEquations {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static BUILT: OnceLock<Mutex<HashMap<String, PathBuf>>> = OnceLock::new();
+    let hash = model.structural_hash();
+    let path = {
+        let mut map = BUILT.get_or_init(|| Mutex::new(HashMap::new())).lock().unwrap();
+        map.entry(hash)
+            .or_insert_with(|| {
+                let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins");
+                let opts = railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
+                railmbs_codegen::build_plugin(model, &opts, Some(cache))
+                    .unwrap_or_else(|e| panic!("{}: {e}", model.name))
+                    .path
+            })
+            .clone()
+    };
+    let plugin = railmbs_runtime::Plugin::load_for(&path, model).unwrap_or_else(|e| panic!("{e}"));
+    let mut eq = railmbs_runtime::PluginEquations::new(plugin);
+    eq.set_parameters(&model.default_parameter_values()).unwrap();
+    eq
+}

@@ -1,0 +1,644 @@
+//! Symbolic derivation of the equations of motion: the same recursive
+//! kinematics and composite-body method as the numeric engine
+//! (`railmbs_runtime::numeric`), carried out on expressions of the `cas` crate.
+//!
+//! Symbols: `q[i]`, `v[i]` (generalized coordinates and velocities), `p[i]`
+//! (the model's identifiers: runtime inputs, so a new value needs no
+//! recompilation), `t` (time, for rheonomic transformations and time-dependent
+//! expressions).
+//!
+//! The composite bodies are kept division-free: for the subtree of body b,
+//! its mass m, first moment h = Σ m_k (c_k − r_b) and inertia J about r_b
+//! (J = Σ [I_k + m_k(|ρ_k|²E − ρ_kρ_kᵀ)], ρ_k = c_k − r_b). For a rotation of
+//! unit rate about axis u through p, the subtree's momentum is
+//! L = u × (m d + h) and its angular momentum about r_b is H = J u + h × (u × d)
+//! with d = r_b − p; a translation along u gives L = m u, H = h × u. Then
+//! M_ij = u_j·(H + (r_b − p_j) × L) for a rotation j and u_j·L for a translation.
+
+use railmbs_cas::{Context, ExprId, Symbol};
+use railmbs_models::{
+    BodyRef, Component, ElementaryKind, Expr, Frame, Func, Model, Motion,
+};
+
+/// A 3-vector of expressions.
+pub type V3 = [ExprId; 3];
+/// A 3×3 matrix of expressions, row-major `m[r][c]`.
+pub type M3 = [[ExprId; 3]; 3];
+
+/// Symbolic vector algebra on a [`Context`].
+pub struct Alg<'a> {
+    pub ctx: &'a mut Context,
+    zero: ExprId,
+    one: ExprId,
+}
+
+impl<'a> Alg<'a> {
+    pub fn new(ctx: &'a mut Context) -> Self {
+        let zero = ctx.num(0.0);
+        let one = ctx.num(1.0);
+        Self { ctx, zero, one }
+    }
+    pub fn zero(&self) -> ExprId {
+        self.zero
+    }
+    pub fn v_zero(&self) -> V3 {
+        [self.zero; 3]
+    }
+    pub fn identity(&self) -> M3 {
+        let (z, o) = (self.zero, self.one);
+        [[o, z, z], [z, o, z], [z, z, o]]
+    }
+    pub fn add(&mut self, a: V3, b: V3) -> V3 {
+        [0, 1, 2].map(|k| self.ctx.add(a[k], b[k]))
+    }
+    pub fn sub(&mut self, a: V3, b: V3) -> V3 {
+        [0, 1, 2].map(|k| self.ctx.sub(a[k], b[k]))
+    }
+    pub fn scale(&mut self, s: ExprId, a: V3) -> V3 {
+        [0, 1, 2].map(|k| self.ctx.mul(s, a[k]))
+    }
+    pub fn scale_num(&mut self, s: f64, a: V3) -> V3 {
+        [0, 1, 2].map(|k| self.ctx.scale(s, a[k]))
+    }
+    pub fn dot(&mut self, a: V3, b: V3) -> ExprId {
+        let t = [0, 1, 2].map(|k| self.ctx.mul(a[k], b[k]));
+        self.ctx.add_many(&t)
+    }
+    pub fn cross(&mut self, a: V3, b: V3) -> V3 {
+        let c = |s: &mut Self, i: usize, j: usize| {
+            let x = s.ctx.mul(a[i], b[j]);
+            let y = s.ctx.mul(a[j], b[i]);
+            s.ctx.sub(x, y)
+        };
+        [c(self, 1, 2), c(self, 2, 0), c(self, 0, 1)]
+    }
+    pub fn column(&self, m: &M3, k: usize) -> V3 {
+        [m[0][k], m[1][k], m[2][k]]
+    }
+    pub fn mat_vec(&mut self, m: &M3, x: V3) -> V3 {
+        [0, 1, 2].map(|r| {
+            let t = [0, 1, 2].map(|c| self.ctx.mul(m[r][c], x[c]));
+            self.ctx.add_many(&t)
+        })
+    }
+    pub fn mat_t_vec(&mut self, m: &M3, x: V3) -> V3 {
+        [0, 1, 2].map(|c| {
+            let t = [0, 1, 2].map(|r| self.ctx.mul(m[r][c], x[r]));
+            self.ctx.add_many(&t)
+        })
+    }
+    pub fn mat_mul(&mut self, a: &M3, b: &M3) -> M3 {
+        [0, 1, 2].map(|r| {
+            [0, 1, 2].map(|c| {
+                let t = [0, 1, 2].map(|k| self.ctx.mul(a[r][k], b[k][c]));
+                self.ctx.add_many(&t)
+            })
+        })
+    }
+    pub fn mat_add(&mut self, a: &M3, b: &M3) -> M3 {
+        [0, 1, 2].map(|r| [0, 1, 2].map(|c| self.ctx.add(a[r][c], b[r][c])))
+    }
+    /// A R Aᵀ for symmetric R.
+    pub fn rotate_tensor(&mut self, a: &M3, r: &M3) -> M3 {
+        let ar = self.mat_mul(a, r);
+        let mut out = [[self.zero; 3]; 3];
+        for i in 0..3 {
+            for j in i..3 {
+                let t = [0, 1, 2].map(|k| self.ctx.mul(ar[i][k], a[j][k]));
+                out[i][j] = self.ctx.add_many(&t);
+                out[j][i] = out[i][j];
+            }
+        }
+        out
+    }
+    /// m(|d|² E − d dᵀ) (parallel-axis term).
+    pub fn steiner(&mut self, m: ExprId, d: V3) -> M3 {
+        let sq = d.map(|x| self.ctx.powi(x, 2));
+        let mut out = [[self.zero; 3]; 3];
+        for i in 0..3 {
+            for j in i..3 {
+                let e = if i == j {
+                    let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                    self.ctx.add(sq[a], sq[b])
+                } else {
+                    let x = self.ctx.mul(d[i], d[j]);
+                    self.ctx.neg(x)
+                };
+                out[i][j] = self.ctx.mul(m, e);
+                out[j][i] = out[i][j];
+            }
+        }
+        out
+    }
+    /// h eᵀ + e hᵀ (symmetric).
+    pub fn sym_outer(&mut self, h: V3, e: V3) -> M3 {
+        let mut out = [[self.zero; 3]; 3];
+        for i in 0..3 {
+            for j in i..3 {
+                let a = self.ctx.mul(h[i], e[j]);
+                let b = self.ctx.mul(e[i], h[j]);
+                out[i][j] = self.ctx.add(a, b);
+                out[j][i] = out[i][j];
+            }
+        }
+        out
+    }
+    /// Elementary rotation matrix about axis k by angle s.
+    pub fn rotation(&mut self, axis: usize, s: ExprId) -> M3 {
+        let c = self.ctx.cos(s);
+        let sn = self.ctx.sin(s);
+        let ms = self.ctx.neg(sn);
+        let (z, o) = (self.zero, self.one);
+        match axis {
+            0 => [[o, z, z], [z, c, ms], [z, sn, c]],
+            1 => [[c, z, sn], [z, o, z], [ms, z, c]],
+            _ => [[c, ms, z], [sn, c, z], [z, z, o]],
+        }
+    }
+}
+
+/// Which identifiers are replaced by their default values at generation time.
+#[derive(Debug, Clone, Default)]
+pub struct DeriveOptions {
+    /// Parameter indices to fix (constant-folded; changing them then needs regeneration).
+    pub fixed: Vec<usize>,
+    /// Default parameter values (needed for `fixed`).
+    pub defaults: Vec<f64>,
+}
+
+/// The derived equations: expression lists in the order the plugin ABI writes them.
+pub struct Derived {
+    pub ctx: Context,
+    /// Upper triangle of M by columns: for j in 0..n, i in 0..=j → M[(i, j)]; with the
+    /// (i, j) pairs in `mass_index`. Structural zeros are left out.
+    pub mass: Vec<ExprId>,
+    pub mass_index: Vec<(usize, usize)>,
+    pub bias: Vec<ExprId>,
+    pub gravity: Vec<ExprId>,
+    /// Per body: r (3), A column-major (9), v (3), ω (3).
+    pub kinematics: Vec<ExprId>,
+    /// Nonzero entries of the stacked Γ (6·nb × n): value and (row, column).
+    pub jacobians: Vec<ExprId>,
+    pub jacobian_index: Vec<(usize, usize)>,
+    pub constraints: Vec<ExprId>,
+    /// Nonzero entries of G (nc × n).
+    pub constraint_jacobian: Vec<ExprId>,
+    pub constraint_jacobian_index: Vec<(usize, usize)>,
+    pub dof: usize,
+    pub bodies: usize,
+}
+
+/// Converts a model expression into the context.
+pub fn expr_to_cas(ctx: &mut Context, e: &Expr, opts: &DeriveOptions) -> ExprId {
+    match e {
+        Expr::Num(x) => ctx.num(*x),
+        Expr::Param(i) => {
+            if opts.fixed.contains(i) {
+                ctx.num(opts.defaults[*i])
+            } else {
+                ctx.sym(Symbol::p(*i as u32))
+            }
+        }
+        Expr::Time => ctx.sym(Symbol::t()),
+        Expr::Neg(a) => {
+            let a = expr_to_cas(ctx, a, opts);
+            ctx.neg(a)
+        }
+        Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b) | Expr::Div(a, b) => {
+            let x = expr_to_cas(ctx, a, opts);
+            let y = expr_to_cas(ctx, b, opts);
+            match e {
+                Expr::Add(..) => ctx.add(x, y),
+                Expr::Sub(..) => ctx.sub(x, y),
+                Expr::Mul(..) => ctx.mul(x, y),
+                _ => ctx.div(x, y),
+            }
+        }
+        Expr::Pow(a, b) => {
+            let x = expr_to_cas(ctx, a, opts);
+            let y = expr_to_cas(ctx, b, opts);
+            match ctx.as_num(y) {
+                Some(n) if n.fract() == 0.0 && n.abs() <= 64.0 => ctx.powi(x, n as i32),
+                Some(n) if n == 0.5 => ctx.sqrt(x),
+                Some(n) if n == -0.5 => {
+                    let s = ctx.sqrt(x);
+                    ctx.recip(s)
+                }
+                _ => {
+                    // a^b = exp(b ln a) (a > 0), as f64::powf.
+                    let l = ctx.ln(x);
+                    let m = ctx.mul(y, l);
+                    ctx.exp(m)
+                }
+            }
+        }
+        Expr::Call(f, a) => {
+            let x = expr_to_cas(ctx, a, opts);
+            match f {
+                Func::Sin => ctx.sin(x),
+                Func::Cos => ctx.cos(x),
+                Func::Tan => ctx.tan(x),
+                Func::Sqrt => ctx.sqrt(x),
+                Func::Abs => ctx.abs(x),
+                Func::Exp => ctx.exp(x),
+                Func::Ln => ctx.ln(x),
+                Func::Atan => {
+                    let one = ctx.num(1.0);
+                    ctx.atan2(x, one)
+                }
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct State {
+    r: V3,
+    a: M3,
+    v: V3,
+    w: V3,
+    acc0: V3,
+    alpha0: V3,
+}
+
+#[derive(Clone, Copy)]
+struct AxisInfo {
+    rotation: bool,
+    u: V3,
+    p: V3,
+}
+
+/// Derives all equations of `model`.
+pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
+    let mut ctx = Context::new();
+    let n = model.coordinates.len();
+    let nb = model.bodies.len();
+    let mut states: Vec<State> = Vec::with_capacity(nb);
+    let mut axes: Vec<Option<AxisInfo>> = vec![None; n];
+    let mut chains: Vec<Vec<usize>> = Vec::with_capacity(nb);
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    let mut masses = Vec::with_capacity(nb);
+    let mut inertia_g: Vec<M3> = Vec::with_capacity(nb);
+
+    let mut alg = Alg::new(&mut ctx);
+    let gravity: V3 = [0, 1, 2].map(|k| expr_to_cas(alg.ctx, &model.gravity[k], opts));
+
+    // Forward pass (see runtime::numeric for the formulas).
+    for (j, body) in model.bodies.iter().enumerate() {
+        let parent = match body.parent {
+            BodyRef::Ground => None,
+            BodyRef::Body(p) => Some(p),
+        };
+        if let Some(p) = parent {
+            children[p].push(j);
+        }
+        let mut chain = parent.map(|p| chains[p].clone()).unwrap_or_default();
+        let mut s = match parent {
+            Some(p) => states[p],
+            None => State {
+                r: alg.v_zero(),
+                a: alg.identity(),
+                v: alg.v_zero(),
+                w: alg.v_zero(),
+                acc0: alg.v_zero(),
+                alpha0: alg.v_zero(),
+            },
+        };
+        for el in &body.joint {
+            let (rotation, axis) = match el.kind {
+                ElementaryKind::Translation(a) => (false, a.index()),
+                ElementaryKind::Rotation(a) => (true, a.index()),
+            };
+            let zero = alg.zero();
+            let (val, rate, acc) = match &el.motion {
+                Motion::Fixed(e) => (expr_to_cas(alg.ctx, e, opts), zero, zero),
+                Motion::Coordinate(i) => {
+                    chain.push(*i);
+                    (
+                        alg.ctx.sym(Symbol::q(*i as u32)),
+                        alg.ctx.sym(Symbol::v(*i as u32)),
+                        zero,
+                    )
+                }
+                Motion::Time(e) => {
+                    let x = expr_to_cas(alg.ctx, e, opts);
+                    let xd = alg.ctx.diff(x, Symbol::t());
+                    let xdd = alg.ctx.diff(xd, Symbol::t());
+                    (x, xd, xdd)
+                }
+            };
+            let u = alg.column(&s.a, axis);
+            if let Motion::Coordinate(i) = &el.motion {
+                axes[*i] = Some(AxisInfo { rotation, u, p: s.r });
+            }
+            if rotation {
+                let w_rel = alg.scale(rate, u);
+                let c = alg.cross(s.w, w_rel);
+                let ua = alg.scale(acc, u);
+                let t = alg.add(c, ua);
+                s.alpha0 = alg.add(s.alpha0, t);
+                s.w = alg.add(s.w, w_rel);
+                let r = alg.rotation(axis, val);
+                s.a = alg.mat_mul(&s.a, &r);
+            } else {
+                let d = alg.scale(val, u);
+                let v_rel = alg.scale(rate, u);
+                let t1 = alg.cross(s.alpha0, d);
+                let wd = alg.cross(s.w, d);
+                let t2 = alg.cross(s.w, wd);
+                let wv = alg.cross(s.w, v_rel);
+                let t3 = alg.scale_num(2.0, wv);
+                let t4 = alg.scale(acc, u);
+                let sum = alg.add(t1, t2);
+                let sum = alg.add(sum, t3);
+                let sum = alg.add(sum, t4);
+                s.acc0 = alg.add(s.acc0, sum);
+                let dv = alg.add(wd, v_rel);
+                s.v = alg.add(s.v, dv);
+                s.r = alg.add(s.r, d);
+            }
+        }
+        let m = expr_to_cas(alg.ctx, &body.mass, opts);
+        let iv = body.inertia.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
+        let ib = [[iv[0], iv[3], iv[4]], [iv[3], iv[1], iv[5]], [iv[4], iv[5], iv[2]]];
+        inertia_g.push(alg.rotate_tensor(&s.a, &ib));
+        masses.push(m);
+        states.push(s);
+        chains.push(chain);
+    }
+
+    let own_coordinates = |b: usize| -> &[usize] {
+        let parent_len = match model.bodies[b].parent {
+            BodyRef::Ground => 0,
+            BodyRef::Body(p) => chains[p].len(),
+        };
+        &chains[b][parent_len..]
+    };
+
+    // Composite bodies, division-free (module docs).
+    let mut cm: Vec<ExprId> = vec![alg.zero(); nb];
+    let mut ch: Vec<V3> = vec![alg.v_zero(); nb];
+    let mut cj: Vec<M3> = vec![[[alg.zero(); 3]; 3]; nb];
+    for b in (0..nb).rev() {
+        let mut m = masses[b];
+        let mut h = alg.v_zero();
+        let mut j = inertia_g[b];
+        for &c in &children[b] {
+            let e = alg.sub(states[c].r, states[b].r);
+            m = alg.ctx.add(m, cm[c]);
+            let me = alg.scale(cm[c], e);
+            let he = alg.add(me, ch[c]);
+            h = alg.add(h, he);
+            // Shift J_c from r_c to r_b: J_c + 2(h_c·e)E − (h_c eᵀ + e h_cᵀ) + m_c(|e|²E − e eᵀ).
+            let hd = alg.dot(ch[c], e);
+            let hd2 = alg.ctx.scale(2.0, hd);
+            let outer = alg.sym_outer(ch[c], e);
+            let st = alg.steiner(cm[c], e);
+            let mut shift = [[alg.zero(); 3]; 3];
+            for r in 0..3 {
+                for k in 0..3 {
+                    let diag = if r == k { hd2 } else { alg.zero() };
+                    let x = alg.ctx.sub(diag, outer[r][k]);
+                    let x = alg.ctx.add(x, st[r][k]);
+                    shift[r][k] = alg.ctx.add(cj[c][r][k], x);
+                }
+            }
+            j = alg.mat_add(&j, &shift);
+        }
+        cm[b] = m;
+        ch[b] = h;
+        cj[b] = j;
+    }
+
+    // Mass matrix.
+    let mut mass_entries: Vec<((usize, usize), ExprId)> = Vec::new();
+    for b in 0..nb {
+        let rb = states[b].r;
+        let own = own_coordinates(b).to_vec();
+        let chain = chains[b].clone();
+        for &i in &own {
+            let ax = axes[i].expect("coordinate axis set in the forward pass");
+            let (l, hm) = if ax.rotation {
+                let d = alg.sub(rb, ax.p);
+                let md = alg.scale(cm[b], d);
+                let mdh = alg.add(md, ch[b]);
+                let l = alg.cross(ax.u, mdh);
+                let ju = alg.mat_vec(&cj[b], ax.u);
+                let ud = alg.cross(ax.u, d);
+                let hud = alg.cross(ch[b], ud);
+                (l, alg.add(ju, hud))
+            } else {
+                (alg.scale(cm[b], ax.u), alg.cross(ch[b], ax.u))
+            };
+            let pos_i = chain.iter().position(|&c| c == i).expect("own coordinate in chain");
+            for &k in &chain[..=pos_i] {
+                let axk = axes[k].expect("coordinate axis set");
+                let value = if axk.rotation {
+                    let d = alg.sub(rb, axk.p);
+                    let dl = alg.cross(d, l);
+                    let t = alg.add(hm, dl);
+                    alg.dot(axk.u, t)
+                } else {
+                    alg.dot(axk.u, l)
+                };
+                let (r, c) = if k <= i { (k, i) } else { (i, k) };
+                mass_entries.push(((r, c), value));
+            }
+        }
+    }
+    mass_entries.sort_by_key(|((r, c), _)| (*c, *r));
+    let zero = alg.zero();
+    mass_entries.retain(|(_, e)| *e != zero);
+
+    // Body wrenches projected on the coordinates (backward accumulation).
+    let project = |alg: &mut Alg, wrench: &dyn Fn(&mut Alg, usize) -> (V3, V3)| -> Vec<ExprId> {
+        let mut f_sub = vec![alg.v_zero(); nb];
+        let mut n_sub = vec![alg.v_zero(); nb];
+        for b in (0..nb).rev() {
+            let (mut f, mut nn) = wrench(alg, b);
+            for &c in &children[b] {
+                f = alg.add(f, f_sub[c]);
+                let e = alg.sub(states[c].r, states[b].r);
+                let ef = alg.cross(e, f_sub[c]);
+                let t = alg.add(n_sub[c], ef);
+                nn = alg.add(nn, t);
+            }
+            f_sub[b] = f;
+            n_sub[b] = nn;
+        }
+        let mut out = vec![alg.zero(); n];
+        for b in 0..nb {
+            for &i in own_coordinates(b) {
+                let ax = axes[i].expect("coordinate axis set");
+                out[i] = if ax.rotation {
+                    let d = alg.sub(states[b].r, ax.p);
+                    let df = alg.cross(d, f_sub[b]);
+                    let mo = alg.add(n_sub[b], df);
+                    alg.dot(ax.u, mo)
+                } else {
+                    alg.dot(ax.u, f_sub[b])
+                };
+            }
+        }
+        out
+    };
+    let bias = project(&mut alg, &|alg, j| {
+        let s = states[j];
+        let f = alg.scale(masses[j], s.acc0);
+        let ia = alg.mat_vec(&inertia_g[j], s.alpha0);
+        let iw = alg.mat_vec(&inertia_g[j], s.w);
+        let wiw = alg.cross(s.w, iw);
+        (f, alg.add(ia, wiw))
+    });
+    let gravity_q = project(&mut alg, &|alg, j| (alg.scale(masses[j], gravity), alg.v_zero()));
+
+    // Kinematics and Jacobians.
+    let mut kinematics = Vec::with_capacity(18 * nb);
+    let mut jac = Vec::new();
+    for (j, s) in states.iter().enumerate() {
+        kinematics.extend_from_slice(&s.r);
+        for c in 0..3 {
+            for r in 0..3 {
+                kinematics.push(s.a[r][c]);
+            }
+        }
+        kinematics.extend_from_slice(&s.v);
+        kinematics.extend_from_slice(&s.w);
+        for &i in &chains[j] {
+            let ax = axes[i].expect("coordinate axis set");
+            let (lin, ang) = if ax.rotation {
+                let d = alg.sub(s.r, ax.p);
+                (alg.cross(ax.u, d), ax.u)
+            } else {
+                (ax.u, alg.v_zero())
+            };
+            for k in 0..3 {
+                jac.push(((6 * j + k, i), lin[k]));
+                jac.push(((6 * j + 3 + k, i), ang[k]));
+            }
+        }
+    }
+    jac.retain(|(_, e)| *e != zero);
+
+    // Cut-joint constraints.
+    let mut constraints = Vec::new();
+    let mut cjac: Vec<((usize, usize), ExprId)> = Vec::new();
+    let mut row = 0;
+    for cut in &model.cut_joints {
+        let frame_pose = |alg: &mut Alg, body: BodyRef, f: &Frame| -> (V3, M3, Option<usize>) {
+            let o = f.origin.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
+            let ang = f.rotation_xyz.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
+            let rx = alg.rotation(0, ang[0]);
+            let ry = alg.rotation(1, ang[1]);
+            let rz = alg.rotation(2, ang[2]);
+            let rxy = alg.mat_mul(&rx, &ry);
+            let rf = alg.mat_mul(&rxy, &rz);
+            match body {
+                BodyRef::Ground => (o, rf, None),
+                BodyRef::Body(b) => {
+                    let ao = alg.mat_vec(&states[b].a, o);
+                    let p = alg.add(states[b].r, ao);
+                    (p, alg.mat_mul(&states[b].a, &rf), Some(b))
+                }
+            }
+        };
+        let (p1, a1, b1) = frame_pose(&mut alg, cut.body1, &cut.frame1);
+        let (p2, a2, b2) = frame_pose(&mut alg, cut.body2, &cut.frame2);
+        let d = alg.sub(p2, p1);
+        // Partial (δP, δθ) of a frame point w.r.t. coordinate i.
+        let partial = |alg: &mut Alg, b: Option<usize>, p: V3, i: usize| -> Option<(V3, V3)> {
+            let b = b?;
+            if !chains[b].contains(&i) {
+                return None;
+            }
+            let ax = axes[i].expect("coordinate axis set");
+            Some(if ax.rotation {
+                let dd = alg.sub(p, ax.p);
+                (alg.cross(ax.u, dd), ax.u)
+            } else {
+                (ax.u, alg.v_zero())
+            })
+        };
+        for comp in &cut.constrained {
+            let mut grads = vec![alg.zero(); n];
+            let g = match comp {
+                Component::Tx | Component::Ty | Component::Tz => {
+                    let k = match comp {
+                        Component::Tx => 0,
+                        Component::Ty => 1,
+                        _ => 2,
+                    };
+                    let e = alg.column(&a1, k);
+                    let ed = alg.cross(e, d);
+                    for (i, gi) in grads.iter_mut().enumerate() {
+                        let p1i = partial(&mut alg, b1, p1, i);
+                        let p2i = partial(&mut alg, b2, p2, i);
+                        let mut terms = Vec::new();
+                        if let Some((dp2, _)) = p2i {
+                            terms.push(alg.dot(dp2, e));
+                        }
+                        if let Some((dp1, dt1)) = p1i {
+                            let x = alg.dot(dp1, e);
+                            terms.push(alg.ctx.neg(x));
+                            terms.push(alg.dot(dt1, ed));
+                        }
+                        *gi = alg.ctx.add_many(&terms);
+                    }
+                    alg.dot(d, e)
+                }
+                Component::Rx | Component::Ry | Component::Rz => {
+                    let (k1, k2) = match comp {
+                        Component::Rx => (1, 2),
+                        Component::Ry => (2, 0),
+                        _ => (0, 1),
+                    };
+                    let a_k2 = alg.column(&a1, k2);
+                    let b_k1 = alg.column(&a2, k1);
+                    let a_k1 = alg.column(&a1, k1);
+                    let b_k2 = alg.column(&a2, k2);
+                    let c1 = alg.cross(a_k2, b_k1);
+                    let c2 = alg.cross(a_k1, b_k2);
+                    let dc = alg.sub(c1, c2);
+                    for (i, gi) in grads.iter_mut().enumerate() {
+                        let mut dt = alg.v_zero();
+                        if let Some((_, t1)) = partial(&mut alg, b1, p1, i) {
+                            dt = alg.add(dt, t1);
+                        }
+                        if let Some((_, t2)) = partial(&mut alg, b2, p2, i) {
+                            dt = alg.sub(dt, t2);
+                        }
+                        let x = alg.dot(dt, dc);
+                        *gi = alg.ctx.scale(0.5, x);
+                    }
+                    let x = alg.dot(a_k2, b_k1);
+                    let y = alg.dot(a_k1, b_k2);
+                    let diff = alg.ctx.sub(x, y);
+                    alg.ctx.scale(0.5, diff)
+                }
+            };
+            constraints.push(g);
+            for (i, gi) in grads.into_iter().enumerate() {
+                if gi != zero {
+                    cjac.push(((row, i), gi));
+                }
+            }
+            row += 1;
+        }
+    }
+
+    Derived {
+        mass_index: mass_entries.iter().map(|(ix, _)| *ix).collect(),
+        mass: mass_entries.into_iter().map(|(_, e)| e).collect(),
+        bias,
+        gravity: gravity_q,
+        kinematics,
+        jacobian_index: jac.iter().map(|(ix, _)| *ix).collect(),
+        jacobians: jac.into_iter().map(|(_, e)| e).collect(),
+        constraints,
+        constraint_jacobian_index: cjac.iter().map(|(ix, _)| *ix).collect(),
+        constraint_jacobian: cjac.into_iter().map(|(_, e)| e).collect(),
+        dof: n,
+        bodies: nb,
+        ctx,
+    }
+}

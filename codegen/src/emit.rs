@@ -1,0 +1,524 @@
+//! Rust source of a plugin: straight-line code of the CSE'd programs, split into
+//! functions of bounded size, and the flat `extern "C"` interface of
+//! `railmbs_runtime::plugin` (the caller passes the ABI version it loads with,
+//! `railmbs_runtime::plugin::ABI_VERSION`; the layouts below mirror that module).
+//!
+//! Programs (each CSE'd over all its outputs together):
+//! - `dyn`: M (nonzero upper-triangle entries), k, Q_g;
+//! - `kin`: body kinematics and the nonzero entries of the Jacobians Γ;
+//! - `all`: both of the above together (one simulation step with force elements);
+//! - `con`: constraints g and the nonzero entries of G (when the model has cut joints).
+
+use crate::derive::Derived;
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+use railmbs_cas::{Instr, Operand, OpCounts, Program, SymbolKind};
+use railmbs_cas::Func as CasFunc;
+
+/// Where one program output goes: buffer and flat index (column-major for
+/// matrices); a mass entry off the diagonal goes to both triangles.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Target {
+    Mass { row: usize, col: usize },
+    Bias(usize),
+    Gravity(usize),
+    Kinematics(usize),
+    Jacobian(usize),
+    Constraint(usize),
+    ConstraintJacobian(usize),
+}
+
+/// One program with its output targets.
+pub(crate) struct Unit {
+    pub name: &'static str,
+    pub program: Program,
+    pub targets: Vec<Target>,
+}
+
+/// Statistics for `umgen`.
+#[derive(Debug, Clone, Default)]
+pub struct EmitStats {
+    /// Operation count of the unshared expression trees of all outputs.
+    pub ops_tree: OpCounts,
+    /// Operations of the emitted programs (after CSE), summed over programs.
+    pub ops_cse: OpCounts,
+    /// Instructions of the `dyn` program (M, k, Q_g) alone.
+    pub dyn_instructions: usize,
+    /// Lines of generated source.
+    pub source_lines: usize,
+    /// Functions emitted.
+    pub functions: usize,
+}
+
+/// Identity of the generated plugin.
+pub struct PluginHeader<'a> {
+    /// ABI version written into the plugin (the loader's `ABI_VERSION`).
+    pub abi_version: u32,
+    pub model_name: &'a str,
+    pub model_hash: &'a str,
+    pub coordinate_names: Vec<String>,
+    pub parameter_names: Vec<String>,
+    /// Parameters fixed at generation time, with their values (the plugin still
+    /// takes the full parameter vector; the host refuses other values for these).
+    pub fixed: Vec<(usize, f64)>,
+}
+
+pub(crate) fn units(d: &Derived) -> Vec<Unit> {
+    let n = d.dof;
+    let nb6 = 6 * d.bodies;
+    let mut dyn_out = Vec::new();
+    let mut dyn_t = Vec::new();
+    for (e, &(row, col)) in d.mass.iter().zip(&d.mass_index) {
+        dyn_out.push(*e);
+        dyn_t.push(Target::Mass { row, col });
+    }
+    for (i, e) in d.bias.iter().enumerate() {
+        dyn_out.push(*e);
+        dyn_t.push(Target::Bias(i));
+    }
+    for (i, e) in d.gravity.iter().enumerate() {
+        dyn_out.push(*e);
+        dyn_t.push(Target::Gravity(i));
+    }
+    let mut kin_out = Vec::new();
+    let mut kin_t = Vec::new();
+    for (i, e) in d.kinematics.iter().enumerate() {
+        kin_out.push(*e);
+        kin_t.push(Target::Kinematics(i));
+    }
+    for (e, &(r, c)) in d.jacobians.iter().zip(&d.jacobian_index) {
+        kin_out.push(*e);
+        kin_t.push(Target::Jacobian(c * nb6 + r));
+    }
+    let mut all_out = dyn_out.clone();
+    all_out.extend_from_slice(&kin_out);
+    let mut all_t = dyn_t.clone();
+    all_t.extend_from_slice(&kin_t);
+    let mut units = vec![
+        Unit {
+            name: "dyn",
+            program: Program::compile(&d.ctx, &dyn_out),
+            targets: dyn_t,
+        },
+        Unit {
+            name: "kin",
+            program: Program::compile(&d.ctx, &kin_out),
+            targets: kin_t,
+        },
+        Unit {
+            name: "all",
+            program: Program::compile(&d.ctx, &all_out),
+            targets: all_t,
+        },
+    ];
+    if !d.constraints.is_empty() {
+        let nc = d.constraints.len();
+        let mut out = Vec::new();
+        let mut t = Vec::new();
+        for (i, e) in d.constraints.iter().enumerate() {
+            out.push(*e);
+            t.push(Target::Constraint(i));
+        }
+        for (e, &(r, c)) in d.constraint_jacobian.iter().zip(&d.constraint_jacobian_index) {
+            out.push(*e);
+            t.push(Target::ConstraintJacobian(c * nc + r));
+        }
+        units.push(Unit {
+            name: "con",
+            program: Program::compile(&d.ctx, &out),
+            targets: t,
+        });
+    }
+    let _ = n;
+    units
+}
+
+fn lit(x: f64) -> TokenStream {
+    // Exact round-trip literal; the sign goes outside for negative numbers.
+    if x < 0.0 {
+        let l = Literal::f64_suffixed(-x);
+        quote!((-#l))
+    } else {
+        let l = Literal::f64_suffixed(x);
+        quote!(#l)
+    }
+}
+
+fn operand(o: Operand, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+    match o {
+        Operand::Tmp(k) => local(k),
+        Operand::Const(c) => lit(c),
+        Operand::Sym(s) => {
+            let i = s.index as usize;
+            match s.kind {
+                SymbolKind::Coordinate => quote!(q[#i]),
+                SymbolKind::Velocity => quote!(v[#i]),
+                SymbolKind::Parameter => quote!(p[#i]),
+                SymbolKind::Input => quote!(u[#i]),
+                SymbolKind::Time => quote!(t),
+            }
+        }
+    }
+}
+
+fn instr(i: &Instr, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+    let o = |x: Operand| operand(x, local);
+    match *i {
+        Instr::Add(a, b) => {
+            let (a, b) = (o(a), o(b));
+            quote!(#a + #b)
+        }
+        Instr::Sub(a, b) => {
+            let (a, b) = (o(a), o(b));
+            quote!(#a - #b)
+        }
+        Instr::Mul(a, b) => {
+            let (a, b) = (o(a), o(b));
+            quote!(#a * #b)
+        }
+        Instr::Div(a, b) => {
+            let (a, b) = (o(a), o(b));
+            quote!(#a / #b)
+        }
+        Instr::Neg(a) => {
+            let a = o(a);
+            quote!(-#a)
+        }
+        Instr::Atan2(y, x) => {
+            let (y, x) = (o(y), o(x));
+            quote!(f64::atan2(#y, #x))
+        }
+        Instr::Call(f, a) => {
+            let a = o(a);
+            match f {
+                CasFunc::Sin => quote!(f64::sin(#a)),
+                CasFunc::Cos => quote!(f64::cos(#a)),
+                CasFunc::Tan => quote!(f64::tan(#a)),
+                CasFunc::Sqrt => quote!(f64::sqrt(#a)),
+                CasFunc::Exp => quote!(f64::exp(#a)),
+                CasFunc::Ln => quote!(f64::ln(#a)),
+                CasFunc::Abs => quote!(f64::abs(#a)),
+            }
+        }
+    }
+}
+
+/// Statements writing one program output into its buffer.
+fn store(target: Target, value: TokenStream, n: usize) -> TokenStream {
+    match target {
+        Target::Mass { row, col } => {
+            let a = col * n + row;
+            if row == col {
+                quote!(o.mass[#a] = #value;)
+            } else {
+                let b = row * n + col;
+                quote!({ let x = #value; o.mass[#a] = x; o.mass[#b] = x; })
+            }
+        }
+        Target::Bias(i) => quote!(o.bias[#i] = #value;),
+        Target::Gravity(i) => quote!(o.gravity[#i] = #value;),
+        Target::Kinematics(i) => quote!(o.kinematics[#i] = #value;),
+        Target::Jacobian(i) => quote!(o.jacobians[#i] = #value;),
+        Target::Constraint(i) => quote!(o.constraints[#i] = #value;),
+        Target::ConstraintJacobian(i) => quote!(o.constraint_jacobian[#i] = #value;),
+    }
+}
+
+/// Emits the functions of one unit: chunk functions and a driver `eval_<name>`.
+fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) -> TokenStream {
+    let prog = &unit.program;
+    let split = prog
+        .split(max_instrs.max(1))
+        .expect("max_instrs is at least 1");
+    let n_slots = split.n_slots.max(1);
+    let mut fns = Vec::new();
+    let mut calls = Vec::new();
+    // Each program output is written by the chunk that defines it (if it is a
+    // temporary of that chunk) or after the last chunk from the scratch array.
+    let mut writes_in_chunk: Vec<Vec<(usize, u32)>> = vec![Vec::new(); split.chunks.len()];
+    let mut final_writes = Vec::new();
+    for (oi, out) in prog.outputs.iter().enumerate() {
+        match out {
+            Operand::Tmp(k) => {
+                let c = (*k as usize) / max_instrs.max(1);
+                writes_in_chunk[c].push((oi, *k));
+            }
+            other => final_writes.push((oi, *other)),
+        }
+    }
+    for (ci, chunk) in split.chunks.iter().enumerate() {
+        let fname = format_ident!("{}_{}", unit.name, ci);
+        let local = |k: u32| {
+            let id = format_ident!("t{}", k);
+            quote!(#id)
+        };
+        let loads = chunk.loads.iter().map(|&(t, s)| {
+            let id = format_ident!("t{}", t);
+            let s = s as usize;
+            quote!(let #id = s[#s];)
+        });
+        let body = chunk.instrs.clone().map(|k| {
+            let id = format_ident!("t{}", k);
+            let e = instr(&prog.instrs[k], &local);
+            quote!(let #id = #e;)
+        });
+        let stores = chunk.stores.iter().map(|&(t, s)| {
+            let id = format_ident!("t{}", t);
+            let s = s as usize;
+            quote!(s[#s] = #id;)
+        });
+        let writes = writes_in_chunk[ci].iter().map(|&(oi, k)| {
+            let id = format_ident!("t{}", k);
+            store(unit.targets[oi], quote!(#id), n)
+        });
+        fns.push(quote! {
+            #[inline(never)]
+            #[allow(unused_variables)]
+            fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [f64], o: &mut Out) {
+                #(#loads)*
+                #(#body)*
+                #(#stores)*
+                #(#writes)*
+            }
+        });
+        calls.push(quote!(#fname(t, q, v, p, u, &mut s, o);));
+        *functions += 1;
+    }
+    let finals = final_writes.iter().map(|&(oi, op)| {
+        let v = operand(op, &|k| {
+            let slot = split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize;
+            quote!(s[#slot])
+        });
+        store(unit.targets[oi], v, n)
+    });
+    let driver = format_ident!("eval_{}", unit.name);
+    *functions += 1;
+    quote! {
+        #(#fns)*
+        #[allow(unused_variables, unused_mut)]
+        fn #driver(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], o: &mut Out) {
+            let mut s = [0.0f64; #n_slots];
+            #(#calls)*
+            #(#finals)*
+        }
+    }
+}
+
+fn c_string_list(names: &[String]) -> Literal {
+    let mut bytes = Vec::new();
+    for n in names {
+        bytes.extend_from_slice(n.as_bytes());
+        bytes.push(0);
+    }
+    bytes.push(0);
+    Literal::byte_string(&bytes)
+}
+
+/// Generates the whole plugin source (formatted).
+pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, EmitStats) {
+    let n = d.dof;
+    let nb = d.bodies;
+    let nc = d.constraints.len();
+    let np = header.parameter_names.len();
+    let units = units(d);
+    let mut stats = EmitStats::default();
+    let mut all_roots: Vec<railmbs_cas::ExprId> = Vec::new();
+    all_roots.extend(&d.mass);
+    all_roots.extend(&d.bias);
+    all_roots.extend(&d.gravity);
+    all_roots.extend(&d.kinematics);
+    all_roots.extend(&d.jacobians);
+    all_roots.extend(&d.constraints);
+    all_roots.extend(&d.constraint_jacobian);
+    stats.ops_tree = d.ctx.tree_op_counts(&all_roots);
+    let mut cse = OpCounts::default();
+    for u in &units {
+        if u.name != "all" {
+            let c = u.program.op_counts();
+            cse = OpCounts {
+                adds: cse.adds + c.adds,
+                muls: cse.muls + c.muls,
+                divs: cse.divs + c.divs,
+                calls: cse.calls + c.calls,
+            };
+        }
+        if u.name == "dyn" {
+            stats.dyn_instructions = u.program.instrs.len();
+        }
+    }
+    stats.ops_cse = cse;
+    let mut functions = 0;
+    let bodies: Vec<TokenStream> = units
+        .iter()
+        .map(|u| emit_unit(u, n, max_instrs, &mut functions))
+        .collect();
+    stats.functions = functions;
+    let has_con = nc > 0;
+    let con_call = if has_con {
+        quote!(if parts & PART_CONSTRAINTS != 0 { eval_con(t, q, v, p, u, &mut o); })
+    } else {
+        quote!()
+    };
+    let abi = header.abi_version;
+    let hash = Literal::byte_string(format!("{}\0", header.model_hash).as_bytes());
+    let name = Literal::byte_string(format!("{}\0", header.model_name).as_bytes());
+    let coords = c_string_list(&header.coordinate_names);
+    let params = c_string_list(&header.parameter_names);
+    let nfixed = header.fixed.len();
+    let fixed_idx: Vec<TokenStream> = header.fixed.iter().map(|&(i, _)| {
+        let i = i as u32;
+        quote!(#i)
+    }).collect();
+    let fixed_val: Vec<TokenStream> = header.fixed.iter().map(|&(_, x)| lit(x)).collect();
+    let (mass_len, bias_len, kin_len, jac_len, con_len, cjac_len) =
+        (n * n, n, 18 * nb, 6 * nb * n, nc, nc * n);
+    let tokens = quote! {
+        //! Generated by railmbs `umgen`: the equations of motion of one model as
+        //! straight-line code. Do not edit; regenerate from the model file.
+        #![allow(clippy::all, non_snake_case, unused_parens)]
+
+        use std::os::raw::c_char;
+
+        const PART_DYNAMICS: u32 = 1;
+        const PART_KINEMATICS: u32 = 2;
+        const PART_CONSTRAINTS: u32 = 4;
+
+        /// Plugin description (see `railmbs_runtime::plugin::PluginInfo`).
+        #[repr(C)]
+        pub struct PluginInfo {
+            pub abi_version: u32,
+            pub dof: u32,
+            pub bodies: u32,
+            pub constraints: u32,
+            pub parameters: u32,
+            pub inputs: u32,
+            pub model_hash: *const c_char,
+            pub model_name: *const c_char,
+            pub coordinate_names: *const c_char,
+            pub parameter_names: *const c_char,
+            pub fixed_count: u32,
+            pub fixed_indices: *const u32,
+            pub fixed_values: *const f64,
+        }
+
+        /// Host-owned input arrays.
+        #[repr(C)]
+        pub struct Inputs {
+            pub t: f64,
+            pub q: *const f64,
+            pub v: *const f64,
+            pub p: *const f64,
+            pub u: *const f64,
+        }
+
+        /// Host-owned output buffers (column-major matrices).
+        #[repr(C)]
+        pub struct Outputs {
+            pub mass: *mut f64,
+            pub bias: *mut f64,
+            pub gravity: *mut f64,
+            pub kinematics: *mut f64,
+            pub jacobians: *mut f64,
+            pub constraints: *mut f64,
+            pub constraint_jacobian: *mut f64,
+        }
+
+        struct Out<'a> {
+            mass: &'a mut [f64],
+            bias: &'a mut [f64],
+            gravity: &'a mut [f64],
+            kinematics: &'a mut [f64],
+            jacobians: &'a mut [f64],
+            constraints: &'a mut [f64],
+            constraint_jacobian: &'a mut [f64],
+        }
+
+        static MODEL_HASH: &[u8] = #hash;
+        static MODEL_NAME: &[u8] = #name;
+        static COORDINATE_NAMES: &[u8] = #coords;
+        static PARAMETER_NAMES: &[u8] = #params;
+        static FIXED_INDICES: [u32; #nfixed] = [#(#fixed_idx),*];
+        static FIXED_VALUES: [f64; #nfixed] = [#(#fixed_val),*];
+
+        #(#bodies)*
+
+        /// Fills `info`. Safety: `info` points to a writable `PluginInfo`.
+        #[no_mangle]
+        pub unsafe extern "C" fn railmbs_plugin_info(info: *mut PluginInfo) {
+            if info.is_null() {
+                return;
+            }
+            *info = PluginInfo {
+                abi_version: #abi,
+                dof: #n as u32,
+                bodies: #nb as u32,
+                constraints: #nc as u32,
+                parameters: #np as u32,
+                inputs: 0,
+                model_hash: MODEL_HASH.as_ptr() as *const c_char,
+                model_name: MODEL_NAME.as_ptr() as *const c_char,
+                coordinate_names: COORDINATE_NAMES.as_ptr() as *const c_char,
+                parameter_names: PARAMETER_NAMES.as_ptr() as *const c_char,
+                fixed_count: #nfixed as u32,
+                fixed_indices: FIXED_INDICES.as_ptr(),
+                fixed_values: FIXED_VALUES.as_ptr(),
+            };
+        }
+
+        /// Evaluates the requested parts. Returns 0, or 1 for a null pointer.
+        /// Safety: every pointer refers to a host buffer of the size stated in
+        /// `railmbs_plugin_info` (M n×n, k and Q_g n, kinematics 18·nb, Γ 6·nb×n,
+        /// g nc, G nc×n); unused parts may be null.
+        #[no_mangle]
+        pub unsafe extern "C" fn railmbs_evaluate(inputs: *const Inputs, parts: u32, outputs: *const Outputs) -> i32 {
+            if inputs.is_null() || outputs.is_null() {
+                return 1;
+            }
+            let i = &*inputs;
+            let ob = &*outputs;
+            unsafe fn sl<'a>(p: *const f64, n: usize) -> &'a [f64] {
+                if n == 0 || p.is_null() { &[] } else { std::slice::from_raw_parts(p, n) }
+            }
+            unsafe fn sl_mut<'a>(p: *mut f64, n: usize) -> &'a mut [f64] {
+                if n == 0 || p.is_null() { &mut [] } else { std::slice::from_raw_parts_mut(p, n) }
+            }
+            let need_dyn = parts & PART_DYNAMICS != 0;
+            let need_kin = parts & PART_KINEMATICS != 0;
+            if (need_dyn && (ob.mass.is_null() || ob.bias.is_null() || ob.gravity.is_null()))
+                || (need_kin && (ob.kinematics.is_null() || ob.jacobians.is_null()))
+                || ((parts & PART_CONSTRAINTS != 0) && #has_con && (ob.constraints.is_null() || ob.constraint_jacobian.is_null()))
+                || (#n > 0 && (i.q.is_null() || i.v.is_null()))
+                || (#np > 0 && i.p.is_null())
+            {
+                return 1;
+            }
+            let t = i.t;
+            let q = sl(i.q, #n);
+            let v = sl(i.v, #n);
+            let p = sl(i.p, #np);
+            let u: &[f64] = &[];
+            let mut o = Out {
+                mass: sl_mut(if need_dyn { ob.mass } else { std::ptr::null_mut() }, #mass_len),
+                bias: sl_mut(if need_dyn { ob.bias } else { std::ptr::null_mut() }, #bias_len),
+                gravity: sl_mut(if need_dyn { ob.gravity } else { std::ptr::null_mut() }, #bias_len),
+                kinematics: sl_mut(if need_kin { ob.kinematics } else { std::ptr::null_mut() }, #kin_len),
+                jacobians: sl_mut(if need_kin { ob.jacobians } else { std::ptr::null_mut() }, #jac_len),
+                constraints: sl_mut(ob.constraints, #con_len),
+                constraint_jacobian: sl_mut(ob.constraint_jacobian, #cjac_len),
+            };
+            if need_dyn && need_kin {
+                eval_all(t, q, v, p, u, &mut o);
+            } else if need_dyn {
+                eval_dyn(t, q, v, p, u, &mut o);
+            } else if need_kin {
+                eval_kin(t, q, v, p, u, &mut o);
+            }
+            #con_call
+            0
+        }
+    };
+    let file: syn::File = syn::parse2(tokens).expect("generated code parses");
+    let text = prettyplease::unparse(&file);
+    stats.source_lines = text.lines().count();
+    (text, stats)
+}
