@@ -225,6 +225,11 @@ impl Substitution {
         if let Some(&r) = self.memo.get(&e) {
             return r;
         }
+        // Subtrees whose dependency summary has none of the replaced symbols stay unchanged.
+        let mask = self.map.keys().fold(0u128, |m, &s| m | symbol_bit(s));
+        if ctx.deps[e.index()] & mask == 0 {
+            return e;
+        }
         // Unvisited part of the DAG below e, in ascending (topological) order.
         let mut order = Vec::new();
         let mut stack = vec![e];
@@ -233,7 +238,12 @@ impl Substitution {
         while let Some(id) = stack.pop() {
             order.push(id);
             ctx.node(id).for_each_child(|c| {
-                if !self.memo.contains_key(&c) && seen.insert(c) {
+                if self.memo.contains_key(&c) {
+                    return;
+                }
+                if ctx.deps[c.index()] & mask == 0 {
+                    self.memo.insert(c, c);
+                } else if seen.insert(c) {
                     stack.push(c);
                 }
             });

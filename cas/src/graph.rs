@@ -323,18 +323,18 @@ pub(crate) type FxMap<K, V> = std::collections::HashMap<K, V, FxBuild>;
 
 const EMPTY: u32 = u32::MAX;
 
-/// The dependency bit of a symbol: coordinates use bits 0–31 (index mod 32), velocities bits
-/// 32–55 (index mod 24), parameters, inputs and time share bits 56–63. Symbols sharing a bit
-/// only make the independence test less sharp, never wrong.
-pub(crate) fn symbol_bit(s: Symbol) -> u64 {
+/// The dependency bit of a symbol: coordinates use bits 0–63 (index mod 64), velocities bits
+/// 64–119 (index mod 56), parameters, inputs and time share bits 120–127. Symbols sharing a
+/// bit only make the independence test less sharp, never wrong.
+pub(crate) fn symbol_bit(s: Symbol) -> u128 {
     let b = match s.kind {
-        SymbolKind::Coordinate => s.index % 32,
-        SymbolKind::Velocity => 32 + s.index % 24,
-        SymbolKind::Parameter => 56 + s.index % 4,
-        SymbolKind::Input => 60 + s.index % 3,
-        SymbolKind::Time => 63,
+        SymbolKind::Coordinate => s.index % 64,
+        SymbolKind::Velocity => 64 + s.index % 56,
+        SymbolKind::Parameter => 120 + s.index % 4,
+        SymbolKind::Input => 124 + s.index % 3,
+        SymbolKind::Time => 127,
     };
-    1u64 << b
+    1u128 << b
 }
 
 /// Normalizes a number for storage: `-0.0` becomes `0.0`.
@@ -347,9 +347,9 @@ fn norm(v: f64) -> f64 {
 pub struct Context {
     pub(crate) nodes: Vec<Node>,
     hashes: Vec<u64>,
-    /// Per node: a 64-bit summary of the symbols it depends on (see [`symbol_bit`]); a clear
+    /// Per node: a 128-bit summary of the symbols it depends on (see [`symbol_bit`]); a clear
     /// bit proves independence, so differentiation skips such subtrees without visiting them.
-    pub(crate) deps: Vec<u64>,
+    pub(crate) deps: Vec<u128>,
     table: Vec<u32>,
     /// Per differentiation variable: derivative of node `i` at index `i` (`EMPTY` = unknown).
     pub(crate) diff_cache: FxMap<Symbol, Vec<u32>>,
@@ -436,7 +436,7 @@ impl Context {
                     .ok()
                     .filter(|&id| id < EMPTY)
                     .expect("railmbs-cas: more than 2^32-1 expression nodes");
-                let mut d = 0u64;
+                let mut d = 0u128;
                 match &node {
                     Node::Sym(s) => d = symbol_bit(*s),
                     other => other.for_each_child(|c| d |= self.deps[c.index()]),
