@@ -2,6 +2,9 @@
 
 use std::fmt;
 
+/// Largest sum that is merged (flattened) into an enclosing sum; see `push_term`.
+pub const FLATTEN_LIMIT: usize = 8;
+
 /// Handle of an expression node in a [`Context`]: a `u32` index into the arena.
 ///
 /// Ids are only meaningful for the context that created them. A node's operands always have
@@ -142,7 +145,8 @@ impl Func {
 ///
 /// * `Num` holds a number with `-0.0` normalized to `0.0`.
 /// * `Add { constant, terms }` is `constant + Σ cᵢ·bᵢ`: terms sorted by id, distinct bases, no zero
-///   coefficient, no base that is a `Num` or an `Add`. Either it has ≥ 2 terms, or one term with
+///   coefficient, no base that is a `Num` or an `Add` of at most [`FLATTEN_LIMIT`] terms (larger
+///   sums stay one shared operand). Either it has ≥ 2 terms, or one term with
 ///   `constant ≠ 0` or `c ≠ 1`. A *scaled term* `c·b` is an `Add` with `constant = 0` and one term;
 ///   negation is the scaled term with `c = −1`.
 /// * `Mul { factors }` is `Π bᵢ^kᵢ` with integer `kᵢ ≠ 0`: sorted by id, distinct bases, no base
@@ -585,10 +589,16 @@ impl Context {
     fn push_term(&self, constant: &mut f64, terms: &mut Vec<(ExprId, f64)>, x: ExprId, c: f64) {
         match self.node(x) {
             Node::Num(v) => *constant += c * v,
+            // Sums of more than FLATTEN_LIMIT terms stay one shared operand: recursive
+            // accumulations (positions down a chain, composite bodies, moments carried
+            // joint by joint) then cost O(1) per step instead of a fresh O(depth) sum,
+            // which made the equations of an N-link chain O(N³). Like terms inside such
+            // a sum no longer meet terms outside it (a lost cancellation, never a wrong
+            // value).
             Node::Add {
                 constant: k,
                 terms: ts,
-            } => {
+            } if ts.len() <= FLATTEN_LIMIT => {
                 *constant += c * k;
                 terms.extend(ts.iter().map(|&(b, d)| (b, c * d)));
             }

@@ -63,7 +63,11 @@
 //!
 //! * constant folding of sums, products and functions of numbers;
 //! * identities `x + 0`, `x·1`, `x·0 = 0`, `x⁰ = 1`, `x¹ = x`;
-//! * flattening of nested sums and products; numeric factors of products are pulled out
+//! * flattening of nested products, and of nested sums of at most [`FLATTEN_LIMIT`] (8) terms:
+//!   a larger sum stays one shared operand of the enclosing sum, so recursive accumulations
+//!   (positions down a chain, composite-body sums) cost O(1) per step instead of re-flattening
+//!   O(depth) terms; the price is that like terms inside such a sum do not meet terms outside
+//!   it (a missed cancellation, never a wrong value); numeric factors of products are pulled out
 //!   (`2x·3y = 6·(x·y)`), and a number times a sum is distributed (`2·(x + y) = 2x + 2y`);
 //! * like terms `c₁x + c₂x = (c₁+c₂)x` and like factors `x·x = x²`, `x·x⁻¹ = 1` (so `x/x = 1`,
 //!   as every CAS does, ignoring x = 0);
@@ -127,6 +131,8 @@ mod program;
 
 pub use calculus::Substitution;
 pub use eval::{CasError, Values};
-pub use graph::{Context, Display, ExprId, Func, Node, ONE, Symbol, SymbolKind, ZERO};
+pub use graph::{
+    Context, Display, ExprId, FLATTEN_LIMIT, Func, Node, ONE, Symbol, SymbolKind, ZERO,
+};
 pub use linalg::{IDENTITY, Mat3, Vec3};
 pub use program::{Chunk, Instr, OpCounts, Operand, Program, SplitProgram};

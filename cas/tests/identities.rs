@@ -44,6 +44,36 @@ fn hash_consing_and_commutativity() {
 }
 
 #[test]
+fn large_sums_stay_shared_operands() {
+    use railmbs_cas::FLATTEN_LIMIT;
+    let mut c = Context::new();
+    let qs: Vec<ExprId> = (0..FLATTEN_LIMIT as u32 + 2).map(|i| c.q(i)).collect();
+    let x = c.p(0);
+    // a sum of FLATTEN_LIMIT terms is merged into an enclosing sum …
+    let small = c.add_many(&qs[..FLATTEN_LIMIT]);
+    let s1 = c.add(small, x);
+    assert!(matches!(c.node(s1), Node::Add { terms, .. } if terms.len() == FLATTEN_LIMIT + 1));
+    // … a larger one stays one operand (same value)
+    let big = c.add_many(&qs[..FLATTEN_LIMIT + 1]);
+    let s2 = c.add(big, x);
+    assert!(matches!(c.node(s2), Node::Add { terms, .. } if terms.len() == 2));
+    let q: Vec<f64> = (0..FLATTEN_LIMIT + 2).map(|i| 0.25 * i as f64).collect();
+    let vals = Values {
+        q: &q,
+        p: &[0.5],
+        ..Default::default()
+    };
+    let v = c.eval(&[s2], &vals).unwrap()[0];
+    let want: f64 = q[..FLATTEN_LIMIT + 1].iter().sum::<f64>() + 0.5;
+    assert_eq!(v, want, "sums of quarters are exact");
+    // like terms are still collected between whole shared sums: big − big = 0, 2·big + big
+    assert_eq!(c.sub(big, big), ZERO);
+    let b2 = c.scale(2.0, big);
+    let b3 = c.add(b2, big);
+    assert_eq!(c.eval(&[b3], &vals).unwrap()[0], 3.0 * (want - 0.5));
+}
+
+#[test]
 fn constant_folding() {
     let mut c = Context::new();
     let two = c.num(2.0);
