@@ -22,27 +22,31 @@
 //! with all spatial quantities taken about points of the mechanism (never the
 //! distant SC0 origin) so that a vehicle 10 km down the track loses no digits.
 //! k and Q_g come from one backward accumulation of body wrenches (O(n)).
+//!
+//! Performance: the joint transformations are compiled by `set_parameters`
+//! into a flat list of steps (zero fixed transformations dropped, consecutive
+//! fixed translations or rotations merged, elementary rotations applied to two
+//! columns of A only); all work buffers live in the struct, so an evaluation
+//! never allocates. M_ik is the scalar product of coordinate k's motion vector
+//! (u_k, (p_k − o) × u_k) with the spatial momentum of body i's composite
+//! subtree about the tree's root point o (two 3-vector dot products per entry).
 
 use crate::equations::{BodyKinematics, Equations, Evaluation, Parts};
 use crate::system::SimError;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use railmbs_models::{
     Axis, BodyRef, Component, CutJoint, ElementaryKind, Expr, Frame, Model, Motion,
 };
 
-/// What drives one elementary transformation, resolved for fast evaluation.
+/// What drives one elementary transformation, as read from the model.
 #[derive(Debug, Clone)]
 enum Source {
     /// A constant (evaluated from parameters by `set_parameters`).
-    Fixed { expr: Expr, value: f64 },
+    Fixed(Expr),
     /// Generalized coordinate index.
     Coordinate(usize),
-    /// A function of time with its first and second time derivatives.
-    Time {
-        value: Expr,
-        rate: Expr,
-        acceleration: Expr,
-    },
+    /// A function of time: index into `NumericEquations::time_motions`.
+    Time(usize),
 }
 
 #[derive(Debug, Clone)]
@@ -52,9 +56,41 @@ struct Op {
     source: Source,
 }
 
+/// A rheonomic transformation s(t) with its first and second time derivatives.
+#[derive(Debug, Clone)]
+struct TimeMotion {
+    value: Expr,
+    rate: Expr,
+    acceleration: Expr,
+}
+
+/// One compiled step of the forward pass (built by `set_parameters`).
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// Fixed translation by `value` (m) along axis `axis` of the current frame.
+    AxisShift { axis: usize, value: f64 },
+    /// Fixed translation by `d` (m), given in the current frame (consecutive
+    /// fixed translations merged).
+    Shift { d: Vector3<f64> },
+    /// Fixed rotation A' = A R (consecutive fixed rotations merged).
+    Turn { r: Matrix3<f64> },
+    /// Rotation about axis `axis` of the current frame by coordinate `coord`.
+    CoordRotation { axis: usize, coord: usize },
+    /// Translation along axis `axis` of the current frame by coordinate `coord`.
+    CoordTranslation { axis: usize, coord: usize },
+    /// Rheonomic rotation or translation (`NumericEquations::time_motions[motion]`).
+    Time {
+        rotation: bool,
+        axis: usize,
+        motion: usize,
+    },
+}
+
 #[derive(Debug, Clone)]
 struct BodyData {
     parent: Option<usize>,
+    /// First body of this body's tree (the one whose parent is SC0).
+    root: usize,
     ops: Vec<Op>,
     mass_expr: Expr,
     inertia_expr: [Expr; 6],
@@ -63,6 +99,10 @@ struct BodyData {
     inertia: Matrix3<f64>,
     /// Coordinates on the path from SC0 to this body (inclusive), in order.
     chain: Vec<usize>,
+    /// Where this body's own coordinates start in `chain`.
+    own_start: usize,
+    /// Range of this body's compiled steps in `NumericEquations::steps`.
+    steps: (usize, usize),
 }
 
 /// A fixed frame on a body, evaluated.
@@ -108,17 +148,33 @@ pub struct NumericEquations {
     bodies: Vec<BodyData>,
     children: Vec<Vec<usize>>,
     coordinate_count: usize,
+    /// Body whose joint holds each coordinate.
+    coordinate_body: Vec<usize>,
     parameter_count: usize,
     gravity_expr: [Expr; 3],
     gravity: Vector3<f64>,
     cuts: Vec<CutData>,
     constraint_count: usize,
+    time_motions: Vec<TimeMotion>,
+    steps: Vec<Step>,
     params: Vec<f64>,
     parameters_set: bool,
-    // Work buffers.
+    // Work buffers, sized once by `new`.
     states: Vec<FrameState>,
     axes: Vec<Axis6>,
     inertia_global: Vec<Matrix3<f64>>,
+    /// Composite bodies: mass (kg), centre of mass (m), inertia about it (kg m², SC0 axes).
+    composite_mass: Vec<f64>,
+    composite_center: Vec<Vector3<f64>>,
+    composite_inertia: Vec<Matrix3<f64>>,
+    /// Motion vector of each coordinate about its tree's root point o:
+    /// angular part (u or 0) and linear part ((p − o) × u or u).
+    motion_angular: Vec<Vector3<f64>>,
+    motion_linear: Vec<Vector3<f64>>,
+    /// Subtree wrenches of the backward pass: force (N), moment about the
+    /// body's centre of mass (N m).
+    subtree_force: Vec<Vector3<f64>>,
+    subtree_moment: Vec<Vector3<f64>>,
 }
 
 /// Elementary rotation matrix about axis `k` by angle `s`.
@@ -137,6 +193,68 @@ pub fn xyz_rotation(angles: [f64; 3]) -> Matrix3<f64> {
     elementary_rotation(0, angles[0])
         * elementary_rotation(1, angles[1])
         * elementary_rotation(2, angles[2])
+}
+
+/// A' = A R_k(s) without the full product: with (i, j) the axes following k
+/// cyclically, column i becomes c a_i + s a_j and column j becomes
+/// c a_j − s a_i (column k is unchanged).
+#[inline(always)]
+fn rotate_columns(a: &mut Matrix3<f64>, axis: usize, s: f64) {
+    let (sn, c) = s.sin_cos();
+    let i = (axis + 1) % 3;
+    let j = (axis + 2) % 3;
+    let ai = a.column(i).into_owned();
+    let aj = a.column(j).into_owned();
+    a.set_column(i, &(ai * c + aj * sn));
+    a.set_column(j, &(aj * c - ai * sn));
+}
+
+/// Translation of the frame by `d` (SC0) moving with relative velocity
+/// `v_rel` and acceleration `a_rel` along it:
+/// v' = v + ω×d + v_rel, a⁰' = a⁰ + α⁰×d + ω×(ω×d) + 2 ω×v_rel + a_rel.
+#[inline(always)]
+fn translate(
+    s: &mut FrameState,
+    d: &Vector3<f64>,
+    v_rel: Option<(&Vector3<f64>, &Vector3<f64>)>,
+    with_acc: bool,
+) {
+    let wd = s.w.cross(d);
+    if with_acc {
+        s.acc0 += s.alpha0.cross(d) + s.w.cross(&wd);
+    }
+    s.v += wd;
+    if let Some((vr, ar)) = v_rel {
+        if with_acc {
+            s.acc0 += 2.0 * s.w.cross(vr) + ar;
+        }
+        s.v += vr;
+    }
+    s.r += d;
+}
+
+/// Rotation of the frame about its axis `axis` (u in SC0) by angle `val` with
+/// rate `rate` and prescribed acceleration `acc`:
+/// ω' = ω + u ṡ, α⁰' = α⁰ + ω×(u ṡ) + u s̈, A' = A R_axis(val).
+#[inline(always)]
+fn rotate(
+    s: &mut FrameState,
+    axis: usize,
+    u: &Vector3<f64>,
+    val: f64,
+    rate: f64,
+    acc: f64,
+    with_acc: bool,
+) {
+    let w_rel = u * rate;
+    if with_acc {
+        s.alpha0 += s.w.cross(&w_rel);
+        if acc != 0.0 {
+            s.alpha0 += u * acc;
+        }
+    }
+    s.w += w_rel;
+    rotate_columns(&mut s.a, axis, val);
 }
 
 fn axis_index(a: Axis) -> usize {
@@ -171,60 +289,86 @@ fn finite(value: f64, what: impl FnOnce() -> String) -> Result<f64, SimError> {
     }
 }
 
+/// Backward accumulation of body wrenches `(f_j, n_j)` (about each centre of
+/// mass) over subtrees: `f_sub[j]`, `n_sub[j]` (moment about r_j).
+fn accumulate_wrenches(
+    states: &[FrameState],
+    children: &[Vec<usize>],
+    wrench: impl Fn(usize) -> (Vector3<f64>, Vector3<f64>),
+    f_sub: &mut [Vector3<f64>],
+    n_sub: &mut [Vector3<f64>],
+) {
+    for j in (0..states.len()).rev() {
+        let (mut f, mut n) = wrench(j);
+        let rj = states[j].r;
+        for &c in &children[j] {
+            f += f_sub[c];
+            n += n_sub[c] + (states[c].r - rj).cross(&f_sub[c]);
+        }
+        f_sub[j] = f;
+        n_sub[j] = n;
+    }
+}
+
 impl NumericEquations {
     /// Prepares the engine for `model`. Call [`Equations::set_parameters`] before evaluating.
     pub fn new(model: &Model) -> Self {
         let n = model.coordinates.len();
         let mut bodies: Vec<BodyData> = Vec::with_capacity(model.bodies.len());
         let mut children = vec![Vec::new(); model.bodies.len()];
+        let mut coordinate_body = vec![0; n];
+        let mut time_motions = Vec::new();
         for (j, b) in model.bodies.iter().enumerate() {
             let parent = body_option(b.parent);
             if let Some(p) = parent {
                 children[p].push(j);
             }
+            let root = parent.map_or(j, |p| bodies[p].root);
             let mut chain = parent.map(|p| bodies[p].chain.clone()).unwrap_or_default();
-            let ops = b
-                .joint
-                .iter()
-                .map(|e| {
-                    let (rotation, axis) = match e.kind {
-                        ElementaryKind::Translation(a) => (false, axis_index(a)),
-                        ElementaryKind::Rotation(a) => (true, axis_index(a)),
-                    };
-                    let source = match &e.motion {
-                        Motion::Fixed(x) => Source::Fixed {
-                            expr: x.clone(),
-                            value: 0.0,
-                        },
-                        Motion::Coordinate(i) => {
-                            chain.push(*i);
-                            Source::Coordinate(*i)
+            let own_start = chain.len();
+            let mut ops = Vec::with_capacity(b.joint.len());
+            for e in &b.joint {
+                let (rotation, axis) = match e.kind {
+                    ElementaryKind::Translation(a) => (false, axis_index(a)),
+                    ElementaryKind::Rotation(a) => (true, axis_index(a)),
+                };
+                let source = match &e.motion {
+                    Motion::Fixed(x) => Source::Fixed(x.clone()),
+                    Motion::Coordinate(i) => {
+                        chain.push(*i);
+                        if let Some(cb) = coordinate_body.get_mut(*i) {
+                            *cb = j;
                         }
-                        Motion::Time(x) => {
-                            let rate = x.time_derivative();
-                            let acceleration = rate.time_derivative();
-                            Source::Time {
-                                value: x.clone(),
-                                rate,
-                                acceleration,
-                            }
-                        }
-                    };
-                    Op {
-                        rotation,
-                        axis,
-                        source,
+                        Source::Coordinate(*i)
                     }
-                })
-                .collect();
+                    Motion::Time(x) => {
+                        let rate = x.time_derivative();
+                        let acceleration = rate.time_derivative();
+                        time_motions.push(TimeMotion {
+                            value: x.clone(),
+                            rate,
+                            acceleration,
+                        });
+                        Source::Time(time_motions.len() - 1)
+                    }
+                };
+                ops.push(Op {
+                    rotation,
+                    axis,
+                    source,
+                });
+            }
             bodies.push(BodyData {
                 parent,
+                root,
                 ops,
                 mass_expr: b.mass.clone(),
                 inertia_expr: b.inertia.clone(),
                 mass: 0.0,
                 inertia: Matrix3::zeros(),
                 chain,
+                own_start,
+                steps: (0, 0),
             });
         }
         let cuts: Vec<CutData> = model.cut_joints.iter().map(cut_data).collect();
@@ -234,80 +378,193 @@ impl NumericEquations {
             bodies,
             children,
             coordinate_count: n,
+            coordinate_body,
             parameter_count: model.parameters.len(),
             gravity_expr: model.gravity.clone(),
             gravity: Vector3::zeros(),
             cuts,
             constraint_count,
+            time_motions,
+            steps: Vec::new(),
             params: Vec::new(),
             parameters_set: false,
             states: vec![FrameState::default(); nb],
             axes: vec![Axis6::default(); n],
             inertia_global: vec![Matrix3::zeros(); nb],
+            composite_mass: vec![0.0; nb],
+            composite_center: vec![Vector3::zeros(); nb],
+            composite_inertia: vec![Matrix3::zeros(); nb],
+            motion_angular: vec![Vector3::zeros(); n],
+            motion_linear: vec![Vector3::zeros(); n],
+            subtree_force: vec![Vector3::zeros(); nb],
+            subtree_moment: vec![Vector3::zeros(); nb],
         }
     }
 
-    /// Forward pass: kinematics of all frames and partial velocities.
-    fn forward(&mut self, t: f64, q: &[f64], qd: &[f64]) {
+    /// Compiles the joint transformations of every body into `steps` with the
+    /// current parameter values: fixed transformations of value zero vanish,
+    /// runs of fixed translations become one shift and runs of fixed
+    /// rotations one matrix.
+    fn compile_steps(&mut self) -> Result<(), SimError> {
+        let p = &self.params;
+        let mut steps = Vec::new();
+        for (j, body) in self.bodies.iter_mut().enumerate() {
+            let start = steps.len();
+            for op in &body.ops {
+                let step = match &op.source {
+                    Source::Fixed(expr) => {
+                        let value = finite(expr.eval(p, 0.0), || format!("joint of body #{j}"))?;
+                        if value == 0.0 {
+                            continue;
+                        }
+                        let last = if steps.len() > start {
+                            steps.last_mut()
+                        } else {
+                            None
+                        };
+                        if let Some(last) = last {
+                            match (op.rotation, &mut *last) {
+                                (false, Step::AxisShift { axis, value: v }) => {
+                                    let mut d = Vector3::zeros();
+                                    d[*axis] = *v;
+                                    d[op.axis] += value;
+                                    *last = Step::Shift { d };
+                                    continue;
+                                }
+                                (false, Step::Shift { d }) => {
+                                    d[op.axis] += value;
+                                    continue;
+                                }
+                                (true, Step::Turn { r }) => {
+                                    *r *= elementary_rotation(op.axis, value);
+                                    continue;
+                                }
+                                _ => {}
+                            }
+                        }
+                        if op.rotation {
+                            Step::Turn {
+                                r: elementary_rotation(op.axis, value),
+                            }
+                        } else {
+                            Step::AxisShift {
+                                axis: op.axis,
+                                value,
+                            }
+                        }
+                    }
+                    Source::Coordinate(i) => {
+                        if op.rotation {
+                            Step::CoordRotation {
+                                axis: op.axis,
+                                coord: *i,
+                            }
+                        } else {
+                            Step::CoordTranslation {
+                                axis: op.axis,
+                                coord: *i,
+                            }
+                        }
+                    }
+                    Source::Time(k) => Step::Time {
+                        rotation: op.rotation,
+                        axis: op.axis,
+                        motion: *k,
+                    },
+                };
+                steps.push(step);
+            }
+            body.steps = (start, steps.len());
+        }
+        self.steps = steps;
+        Ok(())
+    }
+
+    /// Forward pass: kinematics of all frames and partial velocities; the bias
+    /// accelerations only `with_acc`, the inertia tensors in SC0 only
+    /// `with_inertia`.
+    fn forward(&mut self, t: f64, q: &[f64], qd: &[f64], with_acc: bool, with_inertia: bool) {
+        let root_state = FrameState {
+            a: Matrix3::identity(),
+            ..FrameState::default()
+        };
         for j in 0..self.bodies.len() {
             let body = &self.bodies[j];
             let mut s = match body.parent {
                 Some(p) => self.states[p],
-                None => FrameState {
-                    a: Matrix3::identity(),
-                    ..FrameState::default()
-                },
+                None => root_state,
             };
-            for op in &body.ops {
-                let (val, rate, acc, coord) = match &op.source {
-                    Source::Fixed { value, .. } => (*value, 0.0, 0.0, None),
-                    Source::Coordinate(i) => (q[*i], qd[*i], 0.0, Some(*i)),
-                    Source::Time {
-                        value,
-                        rate,
-                        acceleration,
-                    } => (
-                        value.eval(&self.params, t),
-                        rate.eval(&self.params, t),
-                        acceleration.eval(&self.params, t),
-                        None,
-                    ),
-                };
-                let u = s.a.column(op.axis).into_owned();
-                if let Some(i) = coord {
-                    self.axes[i] = Axis6 {
-                        rotation: op.rotation,
-                        u,
-                        p: s.r,
-                    };
-                }
-                if op.rotation {
-                    let w_rel = u * rate;
-                    s.alpha0 += s.w.cross(&w_rel) + u * acc;
-                    s.w += w_rel;
-                    s.a *= elementary_rotation(op.axis, val);
-                } else {
-                    let d = u * val;
-                    let v_rel = u * rate;
-                    s.acc0 += s.alpha0.cross(&d)
-                        + s.w.cross(&s.w.cross(&d))
-                        + 2.0 * s.w.cross(&v_rel)
-                        + u * acc;
-                    s.v += s.w.cross(&d) + v_rel;
-                    s.r += d;
+            for step in &self.steps[body.steps.0..body.steps.1] {
+                match *step {
+                    Step::AxisShift { axis, value } => {
+                        let d = s.a.column(axis) * value;
+                        translate(&mut s, &d, None, with_acc);
+                    }
+                    Step::Shift { d } => {
+                        let d = s.a * d;
+                        translate(&mut s, &d, None, with_acc);
+                    }
+                    Step::Turn { r } => s.a *= r,
+                    Step::CoordRotation { axis, coord } => {
+                        let u = s.a.column(axis).into_owned();
+                        self.axes[coord] = Axis6 {
+                            rotation: true,
+                            u,
+                            p: s.r,
+                        };
+                        rotate(&mut s, axis, &u, q[coord], qd[coord], 0.0, with_acc);
+                    }
+                    Step::CoordTranslation { axis, coord } => {
+                        let u = s.a.column(axis).into_owned();
+                        self.axes[coord] = Axis6 {
+                            rotation: false,
+                            u,
+                            p: s.r,
+                        };
+                        let d = u * q[coord];
+                        let v_rel = u * qd[coord];
+                        translate(&mut s, &d, Some((&v_rel, &Vector3::zeros())), with_acc);
+                    }
+                    Step::Time {
+                        rotation,
+                        axis,
+                        motion,
+                    } => {
+                        let m = &self.time_motions[motion];
+                        let val = m.value.eval(&self.params, t);
+                        let rate = m.rate.eval(&self.params, t);
+                        let acc = m.acceleration.eval(&self.params, t);
+                        let u = s.a.column(axis).into_owned();
+                        if rotation {
+                            rotate(&mut s, axis, &u, val, rate, acc, with_acc);
+                        } else {
+                            let d = u * val;
+                            let v_rel = u * rate;
+                            let a_rel = u * acc;
+                            translate(&mut s, &d, Some((&v_rel, &a_rel)), with_acc);
+                        }
+                    }
                 }
             }
             self.states[j] = s;
-            self.inertia_global[j] = s.a * body.inertia * s.a.transpose();
+            if with_inertia {
+                self.inertia_global[j] = s.a * body.inertia * s.a.transpose();
+            }
         }
     }
 
     /// Partial velocity of body `j`'s centre of mass and its angular velocity
     /// with respect to coordinate `i` (which must be on the body's chain).
     fn partial(&self, i: usize, j: usize) -> (Vector3<f64>, Vector3<f64>) {
+        self.partial_at(i, &self.states[j].r)
+    }
+
+    /// Partial velocity of the point `x` (SC0, moving with a body whose chain
+    /// holds coordinate `i`) and the partial angular velocity.
+    fn partial_at(&self, i: usize, x: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         let ax = &self.axes[i];
         if ax.rotation {
-            (ax.u.cross(&(self.states[j].r - ax.p)), ax.u)
+            (ax.u.cross(&(x - ax.p)), ax.u)
         } else {
             (ax.u, Vector3::zeros())
         }
@@ -315,7 +572,13 @@ impl NumericEquations {
 
     /// Generalized force of a subtree wrench (force `f`, moment `n` about the
     /// subtree's reference point `c`) on coordinate `i`.
-    fn project_wrench(&self, i: usize, f: &Vector3<f64>, n: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
+    fn project_wrench(
+        &self,
+        i: usize,
+        f: &Vector3<f64>,
+        n: &Vector3<f64>,
+        c: &Vector3<f64>,
+    ) -> f64 {
         let ax = &self.axes[i];
         if ax.rotation {
             ax.u.dot(&(n + (c - ax.p).cross(f)))
@@ -324,45 +587,65 @@ impl NumericEquations {
         }
     }
 
-    fn mass_matrix(&self, out: &mut Evaluation) {
+    fn mass_matrix(&mut self, mass: &mut DMatrix<f64>) {
         let nb = self.bodies.len();
         // Composite bodies: mass, centre of mass, inertia about it (SC0 axes).
-        let mut cm = vec![0.0; nb];
-        let mut cc = vec![Vector3::zeros(); nb];
-        let mut ci = vec![Matrix3::zeros(); nb];
         for j in (0..nb).rev() {
-            let mut m = self.bodies[j].mass;
+            let body = &self.bodies[j];
+            let children = &self.children[j];
+            let mut m = body.mass;
             let mut first = Vector3::zeros(); // Σ m_k (c_k − r_j)
             let rj = self.states[j].r;
-            for &c in &self.children[j] {
-                m += cm[c];
-                first += cm[c] * (cc[c] - rj);
+            for &c in children {
+                m += self.composite_mass[c];
+                first += self.composite_mass[c] * (self.composite_center[c] - rj);
             }
             let dc = if m > 0.0 { first / m } else { Vector3::zeros() };
-            let center = rj + dc;
             // Parallel-axis theorem about the composite centre.
-            let mut inertia = self.inertia_global[j] + steiner(self.bodies[j].mass, &(-dc));
-            for &c in &self.children[j] {
-                inertia += ci[c] + steiner(cm[c], &(cc[c] - rj - dc));
+            let mut inertia = self.inertia_global[j] + steiner(body.mass, &dc);
+            for &c in children {
+                inertia += self.composite_inertia[c]
+                    + steiner(
+                        self.composite_mass[c],
+                        &(self.composite_center[c] - rj - dc),
+                    );
             }
-            cm[j] = m;
-            cc[j] = center;
-            ci[j] = inertia;
+            self.composite_mass[j] = m;
+            self.composite_center[j] = rj + dc;
+            self.composite_inertia[j] = inertia;
         }
-        let mass = &mut out.mass;
+        // Motion vectors of the coordinates about their tree's root point o
+        // (a point of the mechanism, so no digits are lost far from SC0).
+        for (k, ax) in self.axes.iter().enumerate() {
+            let o = self.states[self.bodies[self.coordinate_body[k]].root].r;
+            if ax.rotation {
+                self.motion_angular[k] = ax.u;
+                self.motion_linear[k] = (ax.p - o).cross(&ax.u);
+            } else {
+                self.motion_angular[k] = Vector3::zeros();
+                self.motion_linear[k] = ax.u;
+            }
+        }
         for (b, body) in self.bodies.iter().enumerate() {
-            // Coordinates of this body's own joint: the tail of its chain.
-            let parent_len = body.parent.map_or(0, |p| self.bodies[p].chain.len());
-            for (pos, &i) in body.chain.iter().enumerate().skip(parent_len) {
+            let o = self.states[body.root].r;
+            let cm = self.composite_mass[b];
+            let cc = self.composite_center[b];
+            let ci = &self.composite_inertia[b];
+            for pos in body.own_start..body.chain.len() {
+                let i = body.chain[pos];
                 let ax = &self.axes[i];
-                // Momentum of the composite subtree moving with unit rate of q_i.
+                // Momentum of the composite subtree moving with unit rate of
+                // q_i: linear, and angular about its centre cc; then about o.
                 let (lin, ang) = if ax.rotation {
-                    (cm[b] * ax.u.cross(&(cc[b] - ax.p)), ci[b] * ax.u)
+                    (cm * ax.u.cross(&(cc - ax.p)), ci * ax.u)
                 } else {
-                    (cm[b] * ax.u, Vector3::zeros())
+                    (cm * ax.u, Vector3::zeros())
                 };
+                let h = ang + (cc - o).cross(&lin);
+                // M_ik = S_k · (h, lin): the generalized force of the momentum
+                // on coordinate k, u_k·(h − (p_k − o)×lin) for a rotation.
                 for &k in &body.chain[..=pos] {
-                    let value = self.project_wrench(k, &lin, &ang, &cc[b]);
+                    let value = self.motion_angular[k].dot(&h) + self.motion_linear[k].dot(&lin);
                     mass[(i, k)] = value;
                     mass[(k, i)] = value;
                 }
@@ -370,31 +653,33 @@ impl NumericEquations {
         }
     }
 
-    /// Backward accumulation of body wrenches `(f_j, n_j)` (about each centre of
-    /// mass) and projection on the coordinates: returns Σ_j Γ_jᵀ (f_j, n_j).
-    fn project_body_wrenches(
-        &self,
-        wrench: impl Fn(usize) -> (Vector3<f64>, Vector3<f64>),
-        out: &mut nalgebra::DVector<f64>,
-    ) {
-        let nb = self.bodies.len();
-        let mut f_sub = vec![Vector3::zeros(); nb];
-        let mut n_sub = vec![Vector3::zeros(); nb];
-        for j in (0..nb).rev() {
-            let (mut f, mut n) = wrench(j);
-            let rj = self.states[j].r;
-            for &c in &self.children[j] {
-                f += f_sub[c];
-                n += n_sub[c] + (self.states[c].r - rj).cross(&f_sub[c]);
-            }
-            f_sub[j] = f;
-            n_sub[j] = n;
-        }
+    /// Projection of the subtree wrenches (about each body's centre of mass)
+    /// on the coordinates: `out_i = Σ_j Γ_jᵀ (f_j, n_j)` per coordinate.
+    fn project_subtree_wrenches(&self, out: &mut DVector<f64>) {
         for (b, body) in self.bodies.iter().enumerate() {
-            let parent_len = body.parent.map_or(0, |p| self.bodies[p].chain.len());
-            for &i in &body.chain[parent_len..] {
-                out[i] = self.project_wrench(i, &f_sub[b], &n_sub[b], &self.states[b].r);
+            let r = &self.states[b].r;
+            let (f, n) = (&self.subtree_force[b], &self.subtree_moment[b]);
+            for &i in &body.chain[body.own_start..] {
+                out[i] = self.project_wrench(i, f, n, r);
             }
+        }
+    }
+
+    /// Pose (position, direction cosines) of a cut-joint frame in SC0.
+    fn frame_pose(&self, f: &FrameData) -> (Vector3<f64>, Matrix3<f64>) {
+        match f.body {
+            Some(b) => {
+                let s = &self.states[b];
+                (s.r + s.a * f.origin, s.a * f.rotation)
+            }
+            None => (f.origin, f.rotation),
+        }
+    }
+
+    fn frame_chain(&self, f: &FrameData) -> &[usize] {
+        match f.body {
+            Some(b) => &self.bodies[b].chain,
+            None => &[],
         }
     }
 
@@ -402,36 +687,16 @@ impl NumericEquations {
         let n = self.coordinate_count;
         let mut row = 0;
         for cut in &self.cuts {
-            // Frame positions, axes, and per-coordinate partials of both frames.
-            let pose = |f: &FrameData| -> (Vector3<f64>, Matrix3<f64>) {
-                match f.body {
-                    Some(b) => {
-                        let s = &self.states[b];
-                        (s.r + s.a * f.origin, s.a * f.rotation)
-                    }
-                    None => (f.origin, f.rotation),
-                }
-            };
-            let (p1, a1) = pose(&cut.frames[0]);
-            let (p2, a2) = pose(&cut.frames[1]);
+            let [f1, f2] = &cut.frames;
+            let (p1, a1) = self.frame_pose(f1);
+            let (p2, a2) = self.frame_pose(f2);
             let d = p2 - p1;
-            // Partial (δP, δθ) of a frame w.r.t. coordinate i.
-            let partial = |f: &FrameData, p: &Vector3<f64>, i: usize| -> (Vector3<f64>, Vector3<f64>) {
-                match f.body {
-                    Some(b) if self.bodies[b].chain.contains(&i) => {
-                        let ax = &self.axes[i];
-                        if ax.rotation {
-                            (ax.u.cross(&(p - ax.p)), ax.u)
-                        } else {
-                            (ax.u, Vector3::zeros())
-                        }
-                    }
-                    _ => (Vector3::zeros(), Vector3::zeros()),
-                }
-            };
             for comp in &cut.components {
+                let jac = &mut out.constraint_jacobian;
+                for i in 0..n {
+                    jac[(row, i)] = 0.0;
+                }
                 let g;
-                let mut grad = vec![0.0; n];
                 match comp {
                     Component::Tx | Component::Ty | Component::Tz => {
                         let k = match comp {
@@ -442,10 +707,14 @@ impl NumericEquations {
                         let e = a1.column(k).into_owned();
                         g = d.dot(&e);
                         // δg = (δP2 − δP1)·e + δθ1·(e × d)
-                        for (i, gi) in grad.iter_mut().enumerate() {
-                            let (dp1, dt1) = partial(&cut.frames[0], &p1, i);
-                            let (dp2, _) = partial(&cut.frames[1], &p2, i);
-                            *gi = (dp2 - dp1).dot(&e) + dt1.dot(&e.cross(&d));
+                        let exd = e.cross(&d);
+                        for &i in self.frame_chain(f1) {
+                            let (dp1, dt1) = self.partial_at(i, &p1);
+                            jac[(row, i)] += dt1.dot(&exd) - dp1.dot(&e);
+                        }
+                        for &i in self.frame_chain(f2) {
+                            let (dp2, _) = self.partial_at(i, &p2);
+                            jac[(row, i)] += dp2.dot(&e);
                         }
                     }
                     Component::Rx | Component::Ry | Component::Rz => {
@@ -461,36 +730,92 @@ impl NumericEquations {
                         let b_k2 = a2.column(k2).into_owned();
                         g = 0.5 * (a_k2.dot(&b_k1) - a_k1.dot(&b_k2));
                         // δ(a·b) = (δθ1 − δθ2)·(a × b)
-                        let c1 = a_k2.cross(&b_k1);
-                        let c2 = a_k1.cross(&b_k2);
-                        for (i, gi) in grad.iter_mut().enumerate() {
-                            let (_, dt1) = partial(&cut.frames[0], &p1, i);
-                            let (_, dt2) = partial(&cut.frames[1], &p2, i);
-                            let dt = dt1 - dt2;
-                            *gi = 0.5 * (dt.dot(&c1) - dt.dot(&c2));
+                        let c = 0.5 * (a_k2.cross(&b_k1) - a_k1.cross(&b_k2));
+                        for &i in self.frame_chain(f1) {
+                            let (_, dt1) = self.partial_at(i, &p1);
+                            jac[(row, i)] += dt1.dot(&c);
+                        }
+                        for &i in self.frame_chain(f2) {
+                            let (_, dt2) = self.partial_at(i, &p2);
+                            jac[(row, i)] -= dt2.dot(&c);
                         }
                     }
                 }
                 out.constraints[row] = g;
-                for (i, gi) in grad.iter().enumerate() {
-                    out.constraint_jacobian[(row, i)] = *gi;
-                }
                 row += 1;
             }
         }
+    }
+
+    /// Checks that `out` has the sizes of this engine for the requested parts.
+    fn check_buffers(&self, parts: Parts, out: &Evaluation) -> Result<(), SimError> {
+        let n = self.coordinate_count;
+        let nb = self.bodies.len();
+        let nc = self.constraint_count;
+        let bad = |what: &str, got: String, want: String| {
+            Err(SimError::Other(format!(
+                "evaluation buffer {what} is {got}, the numeric engine needs {want} \
+                 (create it with Evaluation::for_equations)"
+            )))
+        };
+        if parts.mass && out.mass.shape() != (n, n) {
+            return bad(
+                "mass",
+                format!("{:?}", out.mass.shape()),
+                format!("({n}, {n})"),
+            );
+        }
+        if parts.bias && out.bias.len() != n {
+            return bad("bias", out.bias.len().to_string(), n.to_string());
+        }
+        if parts.gravity && out.gravity.len() != n {
+            return bad("gravity", out.gravity.len().to_string(), n.to_string());
+        }
+        if parts.kinematics && out.bodies.len() != nb {
+            return bad("bodies", out.bodies.len().to_string(), nb.to_string());
+        }
+        if parts.jacobians && out.jacobians.shape() != (6 * nb, n) {
+            return bad(
+                "jacobians",
+                format!("{:?}", out.jacobians.shape()),
+                format!("({}, {n})", 6 * nb),
+            );
+        }
+        if parts.constraints
+            && nc > 0
+            && (out.constraints.len() != nc || out.constraint_jacobian.shape() != (nc, n))
+        {
+            return bad(
+                "constraints",
+                format!(
+                    "{} and {:?}",
+                    out.constraints.len(),
+                    out.constraint_jacobian.shape()
+                ),
+                format!("{nc} and ({nc}, {n})"),
+            );
+        }
+        Ok(())
     }
 }
 
 fn cut_data(c: &CutJoint) -> CutData {
     CutData {
-        frames: [frame_data(c.body1, &c.frame1), frame_data(c.body2, &c.frame2)],
+        frames: [
+            frame_data(c.body1, &c.frame1),
+            frame_data(c.body2, &c.frame2),
+        ],
         components: c.constrained.clone(),
     }
 }
 
-/// Parallel-axis term m(|d|² E − d dᵀ).
+/// Parallel-axis term m(|d|² E − d dᵀ) (the sign of d does not matter).
+#[inline(always)]
 fn steiner(m: f64, d: &Vector3<f64>) -> Matrix3<f64> {
-    m * (Matrix3::identity() * d.norm_squared() - d * d.transpose())
+    let (x, y, z) = (d.x, d.y, d.z);
+    let (xx, yy, zz) = (m * x * x, m * y * y, m * z * z);
+    let (xy, xz, yz) = (m * x * y, m * x * z, m * y * z);
+    Matrix3::new(yy + zz, -xy, -xz, -xy, xx + zz, -yz, -xz, -yz, xx + yy)
 }
 
 impl Equations for NumericEquations {
@@ -518,34 +843,34 @@ impl Equations for NumericEquations {
                 params.len()
             )));
         }
+        self.parameters_set = false;
         self.params = params.to_vec();
         let p = &self.params;
         for (j, body) in self.bodies.iter_mut().enumerate() {
             body.mass = finite(body.mass_expr.eval(p, 0.0), || format!("mass of body #{j}"))?;
-            let i: Vec<f64> = body.inertia_expr.iter().map(|e| e.eval(p, 0.0)).collect();
-            for v in &i {
-                finite(*v, || format!("inertia of body #{j}"))?;
+            let mut i = [0.0; 6];
+            for (k, e) in body.inertia_expr.iter().enumerate() {
+                i[k] = finite(e.eval(p, 0.0), || format!("inertia of body #{j}"))?;
             }
             body.inertia = Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2]);
-            for op in &mut body.ops {
-                if let Source::Fixed { expr, value } = &mut op.source {
-                    *value = finite(expr.eval(p, 0.0), || format!("joint of body #{j}"))?;
-                }
-            }
         }
+        self.compile_steps()?;
+        let p = &self.params;
         for (k, g) in self.gravity_expr.iter().enumerate() {
             self.gravity[k] = finite(g.eval(p, 0.0), || "gravity".into())?;
         }
         for cut in &mut self.cuts {
             for f in &mut cut.frames {
                 for k in 0..3 {
-                    f.origin[k] = finite(f.origin_expr[k].eval(p, 0.0), || "cut joint frame".into())?;
+                    f.origin[k] =
+                        finite(f.origin_expr[k].eval(p, 0.0), || "cut joint frame".into())?;
                 }
-                let angles = [
-                    f.rotation_expr[0].eval(p, 0.0),
-                    f.rotation_expr[1].eval(p, 0.0),
-                    f.rotation_expr[2].eval(p, 0.0),
-                ];
+                let mut angles = [0.0; 3];
+                for (k, a) in angles.iter_mut().enumerate() {
+                    *a = finite(f.rotation_expr[k].eval(p, 0.0), || {
+                        "cut joint frame rotation".into()
+                    })?;
+                }
                 f.rotation = xyz_rotation(angles);
             }
         }
@@ -574,10 +899,11 @@ impl Equations for NumericEquations {
                 v.len()
             )));
         }
-        self.forward(t, q, v);
+        self.check_buffers(parts, out)?;
+        self.forward(t, q, v, parts.bias, parts.mass || parts.bias);
         if parts.kinematics {
-            for (j, s) in self.states.iter().enumerate() {
-                out.bodies[j] = BodyKinematics {
+            for (k, s) in out.bodies.iter_mut().zip(&self.states) {
+                *k = BodyKinematics {
                     position: s.r,
                     rotation: s.a,
                     velocity: s.v,
@@ -586,30 +912,37 @@ impl Equations for NumericEquations {
             }
         }
         if parts.mass {
-            self.mass_matrix(out);
+            self.mass_matrix(&mut out.mass);
         }
         if parts.bias {
-            let mut bias = std::mem::take(&mut out.bias);
-            self.project_body_wrenches(
+            // Inertia wrenches at q̈ = 0: (m a⁰, I α⁰ + ω × I ω) (Newton–Euler).
+            let (states, inertia, bodies) = (&self.states, &self.inertia_global, &self.bodies);
+            accumulate_wrenches(
+                states,
+                &self.children,
                 |j| {
-                    let s = &self.states[j];
-                    let i = &self.inertia_global[j];
+                    let s = &states[j];
+                    let i = &inertia[j];
                     (
-                        self.bodies[j].mass * s.acc0,
+                        bodies[j].mass * s.acc0,
                         i * s.alpha0 + s.w.cross(&(i * s.w)),
                     )
                 },
-                &mut bias,
+                &mut self.subtree_force,
+                &mut self.subtree_moment,
             );
-            out.bias = bias;
+            self.project_subtree_wrenches(&mut out.bias);
         }
         if parts.gravity {
-            let mut gravity = std::mem::take(&mut out.gravity);
-            self.project_body_wrenches(
-                |j| (self.bodies[j].mass * self.gravity, Vector3::zeros()),
-                &mut gravity,
+            let (bodies, g) = (&self.bodies, self.gravity);
+            accumulate_wrenches(
+                &self.states,
+                &self.children,
+                |j| (bodies[j].mass * g, Vector3::zeros()),
+                &mut self.subtree_force,
+                &mut self.subtree_moment,
             );
-            out.gravity = gravity;
+            self.project_subtree_wrenches(&mut out.gravity);
         }
         if parts.jacobians {
             out.jacobians.fill(0.0);
