@@ -777,7 +777,7 @@ pub struct TableSettings {
     pub y_max: f64,
     /// Lateral step (m).
     pub dy: f64,
-    /// Largest roll (m); the table covers `[−roll_max, roll_max]`.
+    /// Largest roll (rad); the table covers `[−roll_max, roll_max]`.
     pub roll_max: f64,
     /// Roll step (rad).
     pub droll: f64,

