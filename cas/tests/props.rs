@@ -13,7 +13,7 @@
 //! Trees have at most ~60 operations; 1e-12·M ≈ 4500 ε·M leaves a wide margin.
 
 use proptest::prelude::*;
-use railmbs_cas::{Context, ExprId, ONE, Program, Symbol, Values};
+use railmbs_cas::{Context, ExprId, ONE, Operand, Program, Symbol, Values};
 
 #[derive(Clone, Debug)]
 enum T {
@@ -362,6 +362,23 @@ proptest! {
         for max in [1usize, 3, 16] {
             let sp = prog.split(max).unwrap();
             prop_assert_eq!(&sp.eval(&prog, &vals).unwrap(), &got);
+        }
+        // topological order and liveness: every read is of an earlier temporary, at or before
+        // its recorded last use; outputs live to the end
+        let last = prog.last_uses();
+        for (k, i) in prog.instrs.iter().enumerate() {
+            let mut ok = true;
+            i.for_each_operand(|o| {
+                if let Operand::Tmp(t) = o {
+                    ok &= (t as usize) < k && last[t as usize] >= k;
+                }
+            });
+            prop_assert!(ok, "instruction t{k} of\n{prog}");
+        }
+        for o in &prog.outputs {
+            if let Operand::Tmp(t) = o {
+                prop_assert_eq!(last[*t as usize], prog.instrs.len());
+            }
         }
         // CSE never costs more than the tree
         prop_assert!(prog.op_counts().total() <= c.tree_op_counts(&es).total());
