@@ -151,6 +151,14 @@ fn report(n: usize) {
     let (wc, cc) = time(&mut || {
         black_box(Program::compile(&d.ctx, &d.outputs).instrs.len());
     });
+    let t = Instant::now();
+    let sp = prog.split(2000).expect("chunk size is positive");
+    println!(
+        "  split into chunks of <= 2000 instructions: {} chunks, {} scratch slots, {:.2} ms",
+        sp.chunks.len(),
+        sp.n_slots,
+        t.elapsed().as_secs_f64() * 1e3
+    );
     println!(
         "  mean of {runs}: derive M,k {wd:.2} ms wall / {cd} ms CPU; CSE {wc:.2} ms wall / {cc} ms CPU"
     );

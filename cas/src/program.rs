@@ -521,6 +521,8 @@ impl Program {
         let mut free: Vec<u32> = Vec::new();
         let mut active: Vec<(usize, u32)> = Vec::new(); // (last chunk, slot)
         let mut n_slots = 0u32;
+        // chunk that last loaded each temporary (dedup of loads in O(1))
+        let mut loaded_in: Vec<usize> = vec![usize::MAX; n];
         let mut chunks = Vec::with_capacity(n_chunks);
         for c in 0..n_chunks {
             let range = c * max_instrs..((c + 1) * max_instrs).min(n);
@@ -541,8 +543,9 @@ impl Program {
                     {
                         let s = slot_of_tmp[t as usize];
                         if let Some(s) = s
-                            && !loads.contains(&(t, s))
+                            && loaded_in[t as usize] != c
                         {
+                            loaded_in[t as usize] = c;
                             loads.push((t, s));
                         }
                     }
