@@ -31,11 +31,13 @@
 //!   creep forces change by less than the tolerance.
 //!
 //! The contact geometry is supplied through [`RailContactGeometry`] — "the
-//! contact geometry at a given rail displacement" — which the wheelset contact
-//! geometry ([`crate::geometry`]) can implement; [`LinearizedContacts`] is a
-//! first-order implementation from the geometry at zero displacement.
+//! contact geometry at a given rail displacement": [`ProfileRailContacts`]
+//! implements it from the wheel and rail profiles ([`crate::geometry`], one- and
+//! two-point contact), [`LinearizedContacts`] to first order from the contacts
+//! at zero displacement.
 
 use crate::creep::{ContactPatch, CreepForces, CreepLaw, Creepages};
+use crate::geometry::{Contact, ContactGeometry};
 use crate::hertz::HertzShape;
 
 /// Most contacts per wheel (tread and flange).
@@ -110,7 +112,11 @@ pub struct RailContact {
 /// (m) and returns how many there are.
 pub trait RailContactGeometry {
     /// Contacts at rail displacement `d`.
-    fn contacts_at(&self, d: [f64; 2], out: &mut [RailContact; MAX_CONTACTS]) -> usize;
+    fn contacts_at(
+        &self,
+        d: [f64; 2],
+        out: &mut [RailContact; MAX_CONTACTS],
+    ) -> Result<usize, ElasticRailError>;
 }
 
 /// First-order contact geometry: the contacts at zero rail displacement, with
@@ -124,7 +130,11 @@ pub struct LinearizedContacts {
 }
 
 impl RailContactGeometry for LinearizedContacts {
-    fn contacts_at(&self, d: [f64; 2], out: &mut [RailContact; MAX_CONTACTS]) -> usize {
+    fn contacts_at(
+        &self,
+        d: [f64; 2],
+        out: &mut [RailContact; MAX_CONTACTS],
+    ) -> Result<usize, ElasticRailError> {
         let n = self.contacts.len().min(MAX_CONTACTS);
         for (o, c) in out.iter_mut().zip(&self.contacts[..n]) {
             *o = RailContact {
@@ -132,7 +142,79 @@ impl RailContactGeometry for LinearizedContacts {
                 ..*c
             };
         }
-        n
+        Ok(n)
+    }
+}
+
+/// Contact geometry from the wheel and rail profiles ([`ContactGeometry`]) for
+/// one wheel of a wheelset at lateral shift `y` (m), roll `roll` (rad) and
+/// height `z` (m, the geometry's vertical wheelset coordinate: the vertical gap
+/// at a contact is `gap + z`), on its rail displaced elastically by `d`:
+///
+/// - the rail moved laterally by `d_y` is the wheelset moved by `−d_y`
+///   relative to that rail (the other side is not used);
+/// - the rail lowered by `−d_z` opens the vertical gap by `−d_z`;
+/// - the approach along the normal is the vertical overlap times `cos δ`
+///   (`δ` the contact angle), the normal `n = (∓sin δ, cos δ)` (left/right wheel:
+///   the normal force on the wheel points towards the track centre for `δ > 0`);
+/// - the Hertz shape from the contact's curvatures (rail rolling-direction
+///   curvature 0) and the material `e` (Pa), `nu`; the creepages from the
+///   caller's `creepages` function of the contact (kinematics are not geometry).
+pub struct ProfileRailContacts<'g, F> {
+    /// The wheelset–track contact geometry.
+    pub geometry: &'g ContactGeometry,
+    /// 0 = left wheel/rail, 1 = right.
+    pub side: usize,
+    /// Wheelset lateral shift, m.
+    pub y: f64,
+    /// Wheelset roll, rad.
+    pub roll: f64,
+    /// Wheelset height, m.
+    pub z: f64,
+    /// Young's modulus of wheel and rail, Pa.
+    pub e: f64,
+    /// Poisson ratio.
+    pub nu: f64,
+    /// Creepages of a contact (rigid rail at rest).
+    pub creepages: F,
+}
+
+impl<F: Fn(&Contact) -> Creepages> RailContactGeometry for ProfileRailContacts<'_, F> {
+    fn contacts_at(
+        &self,
+        d: [f64; 2],
+        out: &mut [RailContact; MAX_CONTACTS],
+    ) -> Result<usize, ElasticRailError> {
+        let geo_err = |index: usize, what: String| ElasticRailError::Geometry { index, what };
+        if self.side > 1 {
+            return Err(geo_err(
+                0,
+                format!("side must be 0 or 1, got {}", self.side),
+            ));
+        }
+        let sets = self
+            .geometry
+            .contacts(self.y - d[0], self.roll)
+            .map_err(|e| geo_err(0, e.to_string()))?;
+        let set = &sets[self.side];
+        let sign = if self.side == 0 { -1.0 } else { 1.0 };
+        let n = set.count.min(MAX_CONTACTS);
+        for (i, (o, c)) in out.iter_mut().zip(&set.contacts[..n]).enumerate() {
+            let (sd, cd) = c.contact_angle.sin_cos();
+            let (ca, cb) = (
+                0.5 * c.wheel_longitudinal_curvature,
+                0.5 * (c.wheel_transverse_curvature + c.rail_transverse_curvature),
+            );
+            let hertz = HertzShape::new(ca, cb, self.e, self.nu)
+                .map_err(|e| geo_err(i, format!("{e} (conformal contact is not Hertzian)")))?;
+            *o = RailContact {
+                approach: -(c.gap + self.z - d[1]) * cd,
+                normal: [sign * sd, cd],
+                hertz,
+                creepages: (self.creepages)(c),
+            };
+        }
+        Ok(n)
     }
 }
 
@@ -286,7 +368,7 @@ pub fn solve(
         let mut residual = f64::INFINITY;
         for _ in 0..settings.max_inner {
             inner_total += 1;
-            n_contacts = geometry.contacts_at(d, &mut geo);
+            n_contacts = geometry.contacts_at(d, &mut geo)?;
             let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
             let mut j = [[keff[0], 0.0], [0.0, keff[1]]];
             for (i, c) in geo[..n_contacts].iter().enumerate() {
@@ -480,7 +562,7 @@ fn residual_at(
     rhs0: [f64; 2],
     creep_t: &[f64; MAX_CONTACTS],
 ) -> Result<f64, ElasticRailError> {
-    let n = geometry.contacts_at(d, geo);
+    let n = geometry.contacts_at(d, geo)?;
     let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
     for (i, c) in geo[..n].iter().enumerate() {
         check_contact(i, c)?;

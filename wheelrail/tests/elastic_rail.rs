@@ -255,3 +255,69 @@ fn damping_and_errors() {
     assert_eq!(s.contacts[0].normal_force, 0.0);
     assert_eq!(s.displacement, [0.0, 0.0]);
 }
+
+/// With the profile contact geometry (S1002 on UIC60 1:40, centred wheelset):
+/// the left wheel lowered 1 mm into its rail on stiff lateral and 100 MN/m
+/// vertical support. The vertical overlap splits into rail deflection and
+/// Hertz approach (springs in series): −d_z + δ/cos δ_c = 1 mm, N follows Hertz
+/// at the final approach, and both equilibria hold.
+#[test]
+fn profile_geometry_static_load() {
+    use railmbs_wheelrail::elastic_rail::ProfileRailContacts;
+    use railmbs_wheelrail::geometry::{ContactGeometry, SearchSettings, Track, Wheelset};
+    use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/profiles/");
+    let s = ProfileSettings::default();
+    let w = Profile::read(
+        std::path::Path::new(&format!("{dir}MBench_S1002_v3.prw")),
+        ProfileKind::Wheel,
+        &s,
+    )
+    .unwrap();
+    let r = Profile::read(
+        std::path::Path::new(&format!("{dir}MBench_UIC60_v3.prr")),
+        ProfileKind::Rail,
+        &s,
+    )
+    .unwrap();
+    let ws = Wheelset::new(w.clone(), w, 0.46, 1.360);
+    let tr = Track::new(r.clone(), r, 1.435);
+    let geo = ContactGeometry::new(&ws, &tr, SearchSettings::default()).unwrap();
+    let c0 = *geo.contacts(0.0, 0.0).unwrap()[0].deepest();
+    let lower = 1.0e-3;
+    let rc = ProfileRailContacts {
+        geometry: &geo,
+        side: 0,
+        y: 0.0,
+        roll: 0.0,
+        z: -c0.gap - lower,
+        e: 210e9,
+        nu: 0.3,
+        creepages: |_c: &railmbs_wheelrail::geometry::Contact| Creepages::default(),
+    };
+    let support = RailSupport {
+        ky: 1e12,
+        cy: 0.0,
+        kz: 100e6,
+        cz: 0.0,
+    };
+    let law = FastsimA::new(10).unwrap();
+    let sol = solve(
+        &support,
+        &steel(),
+        &rc,
+        &law,
+        [0.0; 2],
+        &ElasticRailSettings::default(),
+    )
+    .unwrap();
+    assert!(sol.n_contacts >= 1);
+    let c = &sol.contacts[0];
+    let cosd = c.normal[1];
+    let split = -sol.displacement[1] + c.approach / cosd;
+    assert!((split / lower - 1.0).abs() < 1e-3, "{split}");
+    let load = c.normal_force;
+    assert!(load > 10e3 && load < 200e3, "{load}");
+    assert!((support.kz * sol.displacement[1] + sol.wheel_force[1]).abs() < 1e-8 * load);
+    assert!((support.ky * sol.displacement[0] + sol.wheel_force[0]).abs() < 1e-8 * load + 1e-3);
+}
