@@ -4,6 +4,7 @@
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
+pub mod bench;
 pub mod conicity;
 pub mod creep;
 pub mod engine;

@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{conicity, creep, run};
+use railmbs_cli::{bench, conicity, creep, run};
 
 #[derive(Parser)]
 #[command(name = "umsim", version, about = "railmbs simulator: run scenarios, benchmark engines, wheel-rail tools")]
@@ -14,6 +14,8 @@ struct Cli {
 enum Command {
     /// Simulate a scenario and write its outputs as CSV.
     Run(run::Args),
+    /// Speed of the numeric and symbolic engines on a model.
+    Bench(bench::Args),
     /// Equivalent conicity of a wheelset on a track by EN 15302 (Annex B).
     Conicity(conicity::Args),
     /// Creep forces for a table of contact cases.
@@ -24,6 +26,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run(a) => run::run(a),
+        Command::Bench(a) => bench::run(a),
         Command::Conicity(a) => conicity::run(a),
         Command::Creep(a) => creep::run(a),
     };
