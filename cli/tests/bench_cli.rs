@@ -1,0 +1,121 @@
+//! `umsim bench` end to end: the JSON report.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+const UMSIM: &str = env!("CARGO_BIN_EXE_umsim");
+
+fn root() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+}
+
+fn umsim(args: &[&str]) -> Output {
+    Command::new(UMSIM)
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("umsim starts")
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "umsim bench failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}):\n{stdout}"))
+}
+
+const KEYS: [&str; 10] = [
+    "model",
+    "dof",
+    "numeric_eval_ns",
+    "symbolic_eval_ns",
+    "eval_ratio",
+    "numeric_run_s",
+    "symbolic_run_s",
+    "run_ratio",
+    "derive_s",
+    "compile_s",
+];
+
+fn positive(v: &serde_json::Value, key: &str) -> f64 {
+    let x = v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} is not a number: {}", v[key]));
+    assert!(x > 0.0 && x.is_finite(), "{key} = {x}");
+    x
+}
+
+#[test]
+fn bench_json_has_the_documented_keys() {
+    let v = json(&umsim(&[
+        "bench",
+        "models/mechanisms/chain3.ron",
+        "--json",
+        "--states",
+        "4",
+    ]));
+    for k in KEYS {
+        assert!(v.get(k).is_some(), "key {k} missing in {v}");
+    }
+    assert_eq!(v["model"], "chain3");
+    assert_eq!(v["dof"], 3);
+    positive(&v, "numeric_eval_ns");
+    positive(&v, "numeric_run_s");
+    // models/scenarios/chain3_rk4.ron is the default scenario of chain3.
+    assert!(
+        v["scenario"].as_str().unwrap().ends_with("chain3_rk4.ron"),
+        "{}",
+        v["scenario"]
+    );
+    if v["symbolic_eval_ns"].is_null() {
+        assert!(v["eval_ratio"].is_null());
+        assert!(v["run_ratio"].is_null());
+        assert!(
+            v["symbolic_note"].is_string(),
+            "no reason for the missing symbolic columns"
+        );
+    } else {
+        let ratio = positive(&v, "eval_ratio");
+        let expect = positive(&v, "numeric_eval_ns") / positive(&v, "symbolic_eval_ns");
+        assert!((ratio - expect).abs() <= 1e-12 * expect);
+        positive(&v, "symbolic_run_s");
+        positive(&v, "run_ratio");
+    }
+}
+
+#[test]
+fn bench_numeric_only_leaves_the_symbolic_columns_null() {
+    let v = json(&umsim(&[
+        "bench",
+        "models/mechanisms/pendulum.ron",
+        "--json",
+        "--engine",
+        "numeric",
+        "--states",
+        "2",
+    ]));
+    positive(&v, "numeric_eval_ns");
+    for k in [
+        "symbolic_eval_ns",
+        "eval_ratio",
+        "symbolic_run_s",
+        "run_ratio",
+        "derive_s",
+        "compile_s",
+    ] {
+        assert!(v[k].is_null(), "{k} = {}", v[k]);
+    }
+}
+
+#[test]
+fn bench_rejects_zero_states_and_missing_models() {
+    let o = umsim(&["bench", "models/mechanisms/chain3.ron", "--states", "0"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--states"));
+    let o = umsim(&["bench", "models/mechanisms/no_such_model.ron"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no_such_model.ron"));
+}

@@ -1,0 +1,220 @@
+//! `umsim run` end to end: output file layout, summary, and the errors a user
+//! meets (missing file, unknown parameter, a simulation that blows up).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const UMSIM: &str = env!("CARGO_BIN_EXE_umsim");
+
+/// The repository root (the bundled models live in `models/`).
+fn root() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+}
+
+fn umsim(args: &[&str]) -> Output {
+    Command::new(UMSIM)
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("umsim starts")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Header and rows of a CSV output file.
+fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
+    let content = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let mut lines = content.lines();
+    let header = lines.next().expect("a header line").to_string();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|x| {
+                    x.parse::<f64>()
+                        .unwrap_or_else(|e| panic!("{x:?} in {l:?}: {e}"))
+                })
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn chain3_rk4_run_writes_the_output_grid_and_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let o = umsim(&[
+        "run",
+        "models/scenarios/chain3_rk4.ron",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = text(&o.stdout);
+    assert!(
+        o.status.success(),
+        "umsim run failed:\n{stdout}\n{}",
+        text(&o.stderr)
+    );
+    let (header, rows) = read_csv(&out);
+    assert_eq!(header, "time,q0,q1,q2");
+    // 10 s at an output interval of 0.01 s: rows at 0, 0.01, ..., 10.
+    assert_eq!(rows.len(), 1001);
+    assert_eq!(rows[0][0], 0.0);
+    assert_eq!(rows[1000][0], 10.0);
+    // Initial state of models/mechanisms/chain3.ron: q0 = 0.5 rad, q1 = q2 = 0.
+    assert_eq!(&rows[0][1..], &[0.5, 0.0, 0.0]);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r.len(), 4, "row {k}");
+        // Output times are k·0.01 s (to the rounding of the product).
+        assert!(
+            (r[0] - k as f64 * 0.01).abs() < 1e-12,
+            "row {k} at t = {}",
+            r[0]
+        );
+        assert!(r.iter().all(|x| x.is_finite()), "row {k}: {r:?}");
+    }
+    // RK4 with h = 1 ms over 10 s takes exactly 10 000 steps.
+    let steps = stdout
+        .lines()
+        .find(|l| l.starts_with("steps"))
+        .unwrap_or_else(|| panic!("no steps line in the summary:\n{stdout}"));
+    assert_eq!(steps.split_whitespace().last(), Some("10000"), "{steps}");
+    assert!(
+        stdout.contains("CPU time"),
+        "no CPU time in the summary:\n{stdout}"
+    );
+}
+
+#[test]
+fn missing_scenario_file_is_named_in_the_error() {
+    let o = umsim(&["run", "models/scenarios/no_such_scenario.ron"]);
+    assert!(!o.status.success());
+    let err = text(&o.stderr);
+    assert!(err.contains("no_such_scenario.ron"), "{err}");
+}
+
+#[test]
+fn unknown_scenario_parameter_is_named_with_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = root().join("models/mechanisms/chain3.ron");
+    let scenario = dir.path().join("bad_parameter.ron");
+    std::fs::write(
+        &scenario,
+        format!(
+            "Scenario(\n    model: {:?},\n    parameters: {{ \"no_such_stiffness\": 5.0 }},\n    \
+             end_time: 1.0,\n    integrator: Rk4(step: 0.001),\n    output: (interval: 0.01),\n)\n",
+            model.canonicalize().unwrap().display().to_string()
+        ),
+    )
+    .unwrap();
+    let o = umsim(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "-o",
+        dir.path().join("o.csv").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = text(&o.stderr);
+    assert!(err.contains("bad_parameter.ron"), "{err}");
+    assert!(err.contains("no_such_stiffness"), "{err}");
+}
+
+/// A 1 kg slider on a prismatic x joint pushed by F(t) = 1/(1 − t) N, which
+/// blows up at t = 1 s. From rest at x = 0: v = −ln(1 − t),
+/// x = (1 − t) ln(1 − t) + t.
+const BLOWUP_MODEL: &str = r#"Model(
+    name: "blowup",
+    bodies: [
+        Body(
+            name: "slider",
+            mass: 1.0,
+            inertia: (ixx: 0.01, iyy: 0.01, izz: 0.01),
+            joint: Prismatic(parent: "ground", axis: X, coord: "x"),
+        ),
+    ],
+    forces: [
+        Applied(name: "push", body: "slider", force: ("1/(1-t)", 0, 0)),
+    ],
+)
+"#;
+
+const BLOWUP_SCENARIO: &str = r#"Scenario(
+    model: "blowup.ron",
+    end_time: 2.0,
+    integrator: Rk4(step: 0.001),
+    output: (interval: 0.01),
+)
+"#;
+
+#[test]
+fn diverging_run_fails_with_the_time_and_keeps_the_rows_before_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("blowup.ron"), BLOWUP_MODEL).unwrap();
+    let scenario = dir.path().join("blowup_rk4.ron");
+    std::fs::write(&scenario, BLOWUP_SCENARIO).unwrap();
+    let out = dir.path().join("blowup.csv");
+    let o = umsim(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success(),
+        "a run through a singular force succeeded"
+    );
+    let err = text(&o.stderr);
+    // RK4 steps land on t = 1000 · 1 ms = 1 s, where the force is 1/0.
+    assert!(err.contains("t = 1 s"), "{err}");
+    assert!(
+        err.contains("push"),
+        "the force element is not named: {err}"
+    );
+    assert!(
+        err.contains("blowup_rk4.ron"),
+        "the scenario is not named: {err}"
+    );
+
+    let (header, rows) = read_csv(&out);
+    assert_eq!(header, "time,x");
+    // Rows at 0, 0.01, ..., 0.99 s were written before the failure.
+    assert_eq!(rows.len(), 100, "rows: {}", rows.len());
+    assert!((rows[99][0] - 0.99).abs() < 1e-12);
+    for r in &rows {
+        let t = r[0];
+        let exact = (1.0 - t) * (1.0 - t).ln() + t;
+        // RK4's global error is about h⁴ · max|x⁽⁵⁾| · t with
+        // x⁽⁵⁾ = 6/(1 − t)⁴ ≤ 6e4 m/s⁵ up to t = 0.9 s: 1e-12 · 6e4 · 0.9
+        // ≈ 5e-8 m, so 1e-6 m leaves a wide margin.
+        if t <= 0.9 {
+            assert!((r[1] - exact).abs() < 1e-6, "x({t}) = {} vs {exact}", r[1]);
+        }
+        assert!(r[1].is_finite());
+    }
+}
+
+#[test]
+fn symbolic_engine_runs_or_says_why_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let o = umsim(&[
+        "run",
+        "models/scenarios/chain3_rk4.ron",
+        "--engine",
+        "symbolic",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    if o.status.success() {
+        let (header, rows) = read_csv(&out);
+        assert_eq!(header, "time,q0,q1,q2");
+        assert_eq!(rows.len(), 1001);
+        assert!(text(&o.stdout).contains("symbolic"));
+    } else {
+        let err = text(&o.stderr);
+        assert!(err.contains("symbolic"), "unclear error: {err}");
+    }
+}
