@@ -262,6 +262,13 @@ struct State {
 }
 
 #[derive(Clone, Copy)]
+struct OpNode {
+    parent: Option<usize>,
+    /// Translation of this elementary transformation (SC0), if it is one.
+    d: Option<V3>,
+}
+
+#[derive(Clone, Copy)]
 struct AxisInfo {
     rotation: bool,
     u: V3,
@@ -279,6 +286,13 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); nb];
     let mut masses = Vec::with_capacity(nb);
     let mut inertia_g: Vec<M3> = Vec::with_capacity(nb);
+    // The path of elementary transformations as a tree of op nodes: translation
+    // vector (SC0) and coordinate of each, parent node, and each body's last node.
+    // Relative vectors between points of the mechanism are sums of the
+    // translations between them (short sums, never differences of long ones).
+    let mut ops: Vec<OpNode> = Vec::new();
+    let mut body_end: Vec<Option<usize>> = Vec::with_capacity(nb);
+    let mut op_of: Vec<usize> = vec![0; n];
 
     let mut alg = Alg::new(&mut ctx);
     let gravity: V3 = [0, 1, 2].map(|k| expr_to_cas(alg.ctx, &model.gravity[k], opts));
@@ -293,6 +307,7 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             children[p].push(j);
         }
         let mut chain = parent.map(|p| chains[p].clone()).unwrap_or_default();
+        let mut last_op = parent.and_then(|p| body_end[p]);
         let mut s = match parent {
             Some(p) => states[p],
             None => State {
@@ -328,9 +343,20 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                 }
             };
             let u = alg.column(&s.a, axis);
-            if let Motion::Coordinate(i) = &el.motion {
-                axes[*i] = Some(AxisInfo { rotation, u, p: s.r });
+            let coord = match &el.motion {
+                Motion::Coordinate(i) => Some(*i),
+                _ => None,
+            };
+            if let Some(i) = coord {
+                axes[i] = Some(AxisInfo { rotation, u, p: s.r });
+                op_of[i] = ops.len();
             }
+            let d_op = if rotation { None } else { Some(alg.scale(val, u)) };
+            ops.push(OpNode {
+                parent: last_op,
+                d: d_op,
+            });
+            last_op = Some(ops.len() - 1);
             if rotation {
                 let w_rel = alg.scale(rate, u);
                 let c = alg.cross(s.w, w_rel);
@@ -365,6 +391,59 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         masses.push(m);
         states.push(s);
         chains.push(chain);
+        body_end.push(last_op);
+    }
+    // Σ of the translations on the path from node `from` up to (not including) `stop`.
+    let sum_d = |alg: &mut Alg, from: Option<usize>, stop: Option<usize>| -> V3 {
+        let mut terms: [Vec<ExprId>; 3] = [Vec::new(), Vec::new(), Vec::new()];
+        let mut x = from;
+        while x != stop {
+            let Some(node) = x else { break };
+            if let Some(d) = ops[node].d {
+                for k in 0..3 {
+                    terms[k].push(d[k]);
+                }
+            }
+            x = ops[node].parent;
+        }
+        [0, 1, 2].map(|k| alg.ctx.add_many(&terms[k]))
+    };
+    let parent_end = |b: usize| match model.bodies[b].parent {
+        BodyRef::Ground => None,
+        BodyRef::Body(p) => body_end[p],
+    };
+    // r_c − r_parent(c) for every body.
+    let seg_body: Vec<V3> = (0..nb).map(|c| sum_d(&mut alg, body_end[c], parent_end(c))).collect();
+    // r_b − p_i for every coordinate i of body b.
+    let mut to_com: Vec<V3> = vec![alg.v_zero(); n];
+    let mut coord_body = vec![0usize; n];
+    for b in 0..nb {
+        let pe = parent_end(b);
+        let own: Vec<usize> = {
+            let parent_len = match model.bodies[b].parent {
+                BodyRef::Ground => 0,
+                BodyRef::Body(p) => chains[p].len(),
+            };
+            chains[b][parent_len..].to_vec()
+        };
+        for i in own {
+            coord_body[i] = b;
+            let stop = ops[op_of[i]].parent;
+            let _ = pe;
+            to_com[i] = sum_d(&mut alg, body_end[b], stop);
+        }
+    }
+    // p_i − p_prev(i) for consecutive coordinates on a chain (prev = the
+    // coordinate before i on the path from SC0).
+    let mut seg_coord: Vec<V3> = vec![alg.v_zero(); n];
+    for b in 0..nb {
+        for (pos, &i) in chains[b].iter().enumerate() {
+            if pos == 0 || coord_body[i] != b {
+                continue;
+            }
+            let prev = chains[b][pos - 1];
+            seg_coord[i] = sum_d(&mut alg, ops[op_of[i]].parent, ops[op_of[prev]].parent);
+        }
     }
 
     let own_coordinates = |b: usize| -> &[usize] {
@@ -384,7 +463,7 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         let mut h = alg.v_zero();
         let mut j = inertia_g[b];
         for &c in &children[b] {
-            let e = alg.sub(states[c].r, states[b].r);
+            let e = seg_body[c];
             m = alg.ctx.add(m, cm[c]);
             let me = alg.scale(cm[c], e);
             let he = alg.add(me, ch[c]);
@@ -410,16 +489,17 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         cj[b] = j;
     }
 
-    // Mass matrix.
+    // Mass matrix: momentum (L, H) of the composite subtree for a unit rate of
+    // q_i, carried from joint point to joint point up the chain
+    // (H_prev = H + (p_i − p_prev) × L) and projected on each coordinate.
     let mut mass_entries: Vec<((usize, usize), ExprId)> = Vec::new();
     for b in 0..nb {
-        let rb = states[b].r;
         let own = own_coordinates(b).to_vec();
         let chain = chains[b].clone();
         for &i in &own {
             let ax = axes[i].expect("coordinate axis set in the forward pass");
-            let (l, hm) = if ax.rotation {
-                let d = alg.sub(rb, ax.p);
+            let d = to_com[i];
+            let (l, h_com) = if ax.rotation {
                 let md = alg.scale(cm[b], d);
                 let mdh = alg.add(md, ch[b]);
                 let l = alg.cross(ax.u, mdh);
@@ -430,19 +510,21 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             } else {
                 (alg.scale(cm[b], ax.u), alg.cross(ch[b], ax.u))
             };
+            // About p_i.
+            let dl = alg.cross(d, l);
+            let mut h = alg.add(h_com, dl);
             let pos_i = chain.iter().position(|&c| c == i).expect("own coordinate in chain");
-            for &k in &chain[..=pos_i] {
+            for pos in (0..=pos_i).rev() {
+                let k = chain[pos];
+                if pos < pos_i {
+                    // Move the reference point from p_next to p_k.
+                    let next = chain[pos + 1];
+                    let sl = alg.cross(seg_coord[next], l);
+                    h = alg.add(h, sl);
+                }
                 let axk = axes[k].expect("coordinate axis set");
-                let value = if axk.rotation {
-                    let d = alg.sub(rb, axk.p);
-                    let dl = alg.cross(d, l);
-                    let t = alg.add(hm, dl);
-                    alg.dot(axk.u, t)
-                } else {
-                    alg.dot(axk.u, l)
-                };
-                let (r, c) = if k <= i { (k, i) } else { (i, k) };
-                mass_entries.push(((r, c), value));
+                let value = if axk.rotation { alg.dot(axk.u, h) } else { alg.dot(axk.u, l) };
+                mass_entries.push(((k, i), value));
             }
         }
     }
@@ -458,8 +540,7 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             let (mut f, mut nn) = wrench(alg, b);
             for &c in &children[b] {
                 f = alg.add(f, f_sub[c]);
-                let e = alg.sub(states[c].r, states[b].r);
-                let ef = alg.cross(e, f_sub[c]);
+                let ef = alg.cross(seg_body[c], f_sub[c]);
                 let t = alg.add(n_sub[c], ef);
                 nn = alg.add(nn, t);
             }
@@ -471,8 +552,7 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             for &i in own_coordinates(b) {
                 let ax = axes[i].expect("coordinate axis set");
                 out[i] = if ax.rotation {
-                    let d = alg.sub(states[b].r, ax.p);
-                    let df = alg.cross(d, f_sub[b]);
+                    let df = alg.cross(to_com[i], f_sub[b]);
                     let mo = alg.add(n_sub[b], df);
                     alg.dot(ax.u, mo)
                 } else {

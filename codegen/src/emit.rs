@@ -209,23 +209,55 @@ fn store(target: Target, value: TokenStream, n: usize) -> TokenStream {
         Target::Mass { row, col } => {
             let a = col * n + row;
             if row == col {
-                quote!(o.mass[#a] = #value;)
+                quote!(mass[#a] = #value;)
             } else {
                 let b = row * n + col;
-                quote!({ let x = #value; o.mass[#a] = x; o.mass[#b] = x; })
+                quote!({ let x = #value; mass[#a] = x; mass[#b] = x; })
             }
         }
-        Target::Bias(i) => quote!(o.bias[#i] = #value;),
-        Target::Gravity(i) => quote!(o.gravity[#i] = #value;),
-        Target::Kinematics(i) => quote!(o.kinematics[#i] = #value;),
-        Target::Jacobian(i) => quote!(o.jacobians[#i] = #value;),
-        Target::Constraint(i) => quote!(o.constraints[#i] = #value;),
-        Target::ConstraintJacobian(i) => quote!(o.constraint_jacobian[#i] = #value;),
+        Target::Bias(i) => quote!(bias[#i] = #value;),
+        Target::Gravity(i) => quote!(gravity[#i] = #value;),
+        Target::Kinematics(i) => quote!(kinematics[#i] = #value;),
+        Target::Jacobian(i) => quote!(jacobians[#i] = #value;),
+        Target::Constraint(i) => quote!(constraints[#i] = #value;),
+        Target::ConstraintJacobian(i) => quote!(constraint_jacobian[#i] = #value;),
+    }
+}
+
+fn buffer_name(t: Target) -> &'static str {
+    match t {
+        Target::Mass { .. } => "mass",
+        Target::Bias(_) => "bias",
+        Target::Gravity(_) => "gravity",
+        Target::Kinematics(_) => "kinematics",
+        Target::Jacobian(_) => "jacobians",
+        Target::Constraint(_) => "constraints",
+        Target::ConstraintJacobian(_) => "constraint_jacobian",
+    }
+}
+
+fn buffer_len(name: &str, n: usize, nb: usize, nc: usize) -> usize {
+    match name {
+        "mass" => n * n,
+        "bias" | "gravity" => n,
+        "kinematics" => 18 * nb,
+        "jacobians" => 6 * nb * n,
+        "constraints" => nc,
+        _ => nc * n,
     }
 }
 
 /// Emits the functions of one unit: chunk functions and a driver `eval_<name>`.
-fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) -> TokenStream {
+#[allow(clippy::too_many_arguments)]
+fn emit_unit(
+    unit: &Unit,
+    n: usize,
+    n_params: usize,
+    n_bodies: usize,
+    n_constraints: usize,
+    max_instrs: usize,
+    functions: &mut usize,
+) -> TokenStream {
     let prog = &unit.program;
     let split = prog
         .split(max_instrs.max(1))
@@ -246,6 +278,19 @@ fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) ->
             other => final_writes.push((oi, *other)),
         }
     }
+    // sin and cos of the same argument in one chunk: one `sin_cos` call at the
+    // first of the two instructions.
+    let mut fused_first: std::collections::HashMap<usize, (usize, usize)> = Default::default();
+    let mut fused_skip: std::collections::HashSet<usize> = Default::default();
+    let chunk_of = |k: usize| k / max_instrs.max(1);
+    for (si, ci) in prog.sin_cos_pairs() {
+        let (si, ci) = (si as usize, ci as usize);
+        if chunk_of(si) == chunk_of(ci) {
+            fused_first.insert(si.min(ci), (si, ci));
+            fused_skip.insert(si.max(ci));
+        }
+    }
+    let (nq, np) = (n, n_params);
     for (ci, chunk) in split.chunks.iter().enumerate() {
         let fname = format_ident!("{}_{}", unit.name, ci);
         let local = |k: u32| {
@@ -257,7 +302,13 @@ fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) ->
             let s = s as usize;
             quote!(let #id = s[#s];)
         });
-        let body = chunk.instrs.clone().map(|k| {
+        let body = chunk.instrs.clone().filter(|k| !fused_skip.contains(k)).map(|k| {
+            if let Some(&(si, cj)) = fused_first.get(&k) {
+                let (sid, cid) = (format_ident!("t{}", si), format_ident!("t{}", cj));
+                let Instr::Call(_, a) = prog.instrs[k] else { unreachable!("sin/cos pair") };
+                let a = operand(a, &local);
+                return quote!(let (#sid, #cid) = f64::sin_cos(#a););
+            }
             let id = format_ident!("t{}", k);
             let e = instr(&prog.instrs[k], &local);
             quote!(let #id = #e;)
@@ -267,14 +318,32 @@ fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) ->
             let s = s as usize;
             quote!(s[#s] = #id;)
         });
-        let writes = writes_in_chunk[ci].iter().map(|&(oi, k)| {
-            let id = format_ident!("t{}", k);
-            store(unit.targets[oi], quote!(#id), n)
+        let mut buffers = std::collections::BTreeSet::new();
+        let writes: Vec<TokenStream> = writes_in_chunk[ci]
+            .iter()
+            .map(|&(oi, k)| {
+                let id = format_ident!("t{}", k);
+                buffers.insert(buffer_name(unit.targets[oi]));
+                store(unit.targets[oi], quote!(#id), n)
+            })
+            .collect();
+        // Fixed-size views: one length check per function, then indexing by
+        // constants needs no bounds checks.
+        let views = buffers.iter().map(|b| {
+            let id = format_ident!("{}", b);
+            let len = buffer_len(b, n, n_bodies, n_constraints);
+            quote!(let #id: &mut [f64; #len] = (&mut *o.#id).try_into().expect("host buffer sized by the ABI");)
         });
+        let n_slots_c = n_slots;
         fns.push(quote! {
             #[inline(never)]
             #[allow(unused_variables)]
             fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [f64], o: &mut Out) {
+                let q: &[f64; #nq] = q.try_into().expect("host buffer sized by the ABI");
+                let v: &[f64; #nq] = v.try_into().expect("host buffer sized by the ABI");
+                let p: &[f64; #np] = p.try_into().expect("host buffer sized by the ABI");
+                let s: &mut [f64; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
+                #(#views)*
                 #(#loads)*
                 #(#body)*
                 #(#stores)*
@@ -284,12 +353,15 @@ fn emit_unit(unit: &Unit, n: usize, max_instrs: usize, functions: &mut usize) ->
         calls.push(quote!(#fname(t, q, v, p, u, &mut s, o);));
         *functions += 1;
     }
+    // Outputs that are inputs or constants (rare: e.g. a constant mass entry).
     let finals = final_writes.iter().map(|&(oi, op)| {
         let v = operand(op, &|k| {
             let slot = split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize;
             quote!(s[#slot])
         });
-        store(unit.targets[oi], v, n)
+        let b = format_ident!("{}", buffer_name(unit.targets[oi]));
+        let st = store(unit.targets[oi], v, n);
+        quote!({ let #b = &mut *o.#b; #st })
     });
     let driver = format_ident!("eval_{}", unit.name);
     *functions += 1;
@@ -350,7 +422,7 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let mut functions = 0;
     let bodies: Vec<TokenStream> = units
         .iter()
-        .map(|u| emit_unit(u, n, max_instrs, &mut functions))
+        .map(|u| emit_unit(u, n, np, nb, nc, max_instrs, &mut functions))
         .collect();
     stats.functions = functions;
     let has_con = nc > 0;
