@@ -95,7 +95,6 @@ impl FastsimA {
     /// turns much take the closed form (with a logarithm) in a last pass.
     #[inline]
     fn eval(&self, p: &ContactPatch, c: &Creepages, fl: &Flexibilities) -> CreepForces {
-        const LANES: usize = 8;
         let dy = 2.0 * p.b / self.strip_geom.len() as f64;
         // Bound g = K(aⱼ² − x²) with K such that the strips carry exactly μN.
         let kk = p.mu * p.n / (self.norm * p.a * p.a * p.a * p.b);
@@ -103,105 +102,32 @@ impl FastsimA {
         let cc = 0.5 * c.phi * fl.inv_l3;
         let alpha = kk * kk - cc * cc;
         let bc = bb * cc;
+        let k = StripConsts {
+            a: p.a,
+            b: p.b,
+            kk,
+            bb,
+            cc,
+            alpha,
+            bc,
+            wx: c.xi * fl.inv_l1,
+            wphi: c.phi * fl.inv_l3,
+        };
+        // Full chunks of 8 lanes, the rest in chunks of 2 (a dummy lane of zero
+        // length if odd): every lane computed is a strip.
         let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
-        for chunk in self.strip_geom.chunks(LANES) {
-            let mut aj = [0.0; LANES];
-            let mut y = [0.0; LANES];
-            let mut aa = [0.0; LANES];
-            for (l, &(e, sj)) in chunk.iter().enumerate() {
-                y[l] = e * p.b;
-                aj[l] = p.a * sj;
-                aa[l] = c.xi * fl.inv_l1 - c.phi * y[l] * fl.inv_l3;
-            }
-            let mut sx = [0.0; LANES];
-            let mut sy = [0.0; LANES];
-            let mut sm = [0.0; LANES];
-            let mut xs_l = [0.0; LANES];
-            let mut closed = [false; LANES];
-            // Pass 1: adhesion boundaries of all lanes (independent roots).
-            let mut ts = [0.0; LANES];
-            for l in 0..LANES {
-                let (a_, aj_) = (aa[l], aj[l]);
-                let len = 2.0 * aj_;
-                let w0 = a_ * a_ + bb * bb;
-                // Adhesion boundary: Q(t) = α t² − 2BC t − (A² + B²) = 0, the
-                // cancellation-free root; sliding from the leading edge if
-                // Q(2aⱼ) < 0, no adhesion boundary if there is no slip at all.
-                let q_lead = alpha * len * len - 2.0 * bc * len - w0;
-                let d = (bc * bc + alpha * w0).max(0.0).sqrt();
-                let pos = bc > 0.0;
-                let num = if pos { bc + d } else { w0 };
-                let den = if pos { alpha } else { d - bc };
-
-                let root = num / den;
-                let t = if q_lead < 0.0 {
-                    len
-                } else if w0 == 0.0 {
-                    0.0
-                } else {
-                    root
-                };
-                let tstar = t.max(0.0).min(len);
-                ts[l] = tstar;
-            }
-            // Pass 2: zone integrals.
-            for l in 0..LANES {
-                let (a_, aj_, y_) = (aa[l], aj[l], y[l]);
-                let len = 2.0 * aj_;
-                let tstar = ts[l];
-                let xs = tstar - aj_;
-                let sl = len - tstar;
-                xs_l[l] = xs;
-                // Adhesion zone x* ≤ x ≤ aⱼ: p = (aⱼ − x)(A, B + C(aⱼ + x)).
-                let a2 = aj_ * aj_;
-                let cub = sl * (a2 + aj_ * xs + xs * xs) * (1.0 / 3.0); // (aⱼ³ − x*³)/3
-                let i0 = 0.5 * sl * sl; // ∫(aⱼ − x)
-                let i_par = sl * a2 - cub; // ∫(aⱼ² − x²)
-                let ix_lin = aj_ * sl * tstar * 0.5 - cub; // ∫x(aⱼ − x)
-                let ix_par = a2 * sl * tstar * 0.5 - sl * tstar * (a2 + xs * xs) * 0.25; // ∫x(aⱼ² − x²)
-                let afx = a_ * i0;
-                let afy = bb * i0 + cc * i_par;
-                let amz = bb * ix_lin + cc * ix_par - y_ * afx;
-                // Sliding zone −aⱼ ≤ x ≤ x*: direction d = (A, B' + C x) with
-                // B' = B + C aⱼ (the adhesion solution continued).
-                let ell = tstar;
-                let b2 = bb + cc * aj_;
-                let xm = 0.5 * (xs - aj_);
-                let u = b2 + cc * xm;
-                let w2 = a_ * a_ + u * u;
-                let turn = cc * ell;
-                let taylor = turn * turn <= 0.16 * w2;
-                let (tfx, tfy, tmz) = sliding_taylor(a_, y_, a2, xm, u, w2, cc, kk, ell);
-                let (tfx, tfy, tmz) = if taylor {
-                    (tfx, tfy, tmz)
-                } else {
-                    (0.0, 0.0, 0.0)
-                };
-                closed[l] = !taylor && ell > 0.0;
-                sx[l] = afx + tfx;
-                sy[l] = afy + tfy;
-                sm[l] = amz + tmz;
-            }
-            for l in 0..chunk.len() {
-                if closed[l] {
-                    let s = sliding_closed(
-                        aj[l],
-                        y[l],
-                        aa[l],
-                        bb + cc * aj[l],
-                        cc,
-                        kk,
-                        -aj[l],
-                        xs_l[l],
-                    );
-                    sx[l] += s.fx;
-                    sy[l] += s.fy;
-                    sm[l] += s.mz;
-                }
-                fx += sx[l];
-                fy += sy[l];
-                mz += sm[l];
-            }
+        let n8 = self.strip_geom.len() / 8 * 8;
+        for chunk in self.strip_geom[..n8].chunks(8) {
+            let (x, y, m) = chunk_sums::<8>(chunk, &k);
+            fx += x;
+            fy += y;
+            mz += m;
+        }
+        for chunk in self.strip_geom[n8..].chunks(2) {
+            let (x, y, m) = chunk_sums::<2>(chunk, &k);
+            fx += x;
+            fy += y;
+            mz += m;
         }
         CreepForces {
             fx: -fx * dy,
@@ -238,6 +164,136 @@ fn sqrt_integrals(a2: f64, u1: f64, u2: f64) -> Antiderivs {
     Antiderivs {
         j: [j0, j1, j2, j3, j4],
     }
+}
+
+/// Per-evaluation constants of the strips.
+struct StripConsts {
+    a: f64,
+    b: f64,
+    kk: f64,
+    bb: f64,
+    cc: f64,
+    alpha: f64,
+    bc: f64,
+    /// ξ/L1 and φ/L3.
+    wx: f64,
+    wphi: f64,
+}
+
+/// Force and moment sums (traction on the rail, times 1/Δy) of up to `LANES`
+/// strips processed together.
+#[inline(always)]
+fn chunk_sums<const LANES: usize>(chunk: &[(f64, f64)], k: &StripConsts) -> (f64, f64, f64) {
+    let StripConsts {
+        kk,
+        bb,
+        cc,
+        alpha,
+        bc,
+        ..
+    } = *k;
+    // 1/C for the closed-form sliding zones (only used where C ≠ 0).
+    let inv_cc = 1.0 / cc;
+    let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
+    let mut aj = [0.0; LANES];
+    let mut y = [0.0; LANES];
+    let mut aa = [0.0; LANES];
+    for (l, &(e, sj)) in chunk.iter().enumerate() {
+        y[l] = e * k.b;
+        aj[l] = k.a * sj;
+        aa[l] = k.wx - k.wphi * y[l];
+    }
+    let mut sx = [0.0; LANES];
+    let mut sy = [0.0; LANES];
+    let mut sm = [0.0; LANES];
+    let mut xs_l = [0.0; LANES];
+    let mut closed = [false; LANES];
+    // Pass 1: adhesion boundaries of all lanes (independent roots).
+    let mut ts = [0.0; LANES];
+    for l in 0..LANES {
+        let (a_, aj_) = (aa[l], aj[l]);
+        let len = 2.0 * aj_;
+        let w0 = a_ * a_ + bb * bb;
+        // Adhesion boundary: Q(t) = α t² − 2BC t − (A² + B²) = 0, the
+        // cancellation-free root; sliding from the leading edge if
+        // Q(2aⱼ) < 0, no adhesion boundary if there is no slip at all.
+        let q_lead = alpha * len * len - 2.0 * bc * len - w0;
+        let d = (bc * bc + alpha * w0).max(0.0).sqrt();
+        let pos = bc > 0.0;
+        let num = if pos { bc + d } else { w0 };
+        let den = if pos { alpha } else { d - bc };
+
+        let root = num / den;
+        let t = if q_lead < 0.0 {
+            len
+        } else if w0 == 0.0 {
+            0.0
+        } else {
+            root
+        };
+        let tstar = t.max(0.0).min(len);
+        ts[l] = tstar;
+    }
+    // Pass 2: zone integrals.
+    for l in 0..LANES {
+        let (a_, aj_, y_) = (aa[l], aj[l], y[l]);
+        let len = 2.0 * aj_;
+        let tstar = ts[l];
+        let xs = tstar - aj_;
+        let sl = len - tstar;
+        xs_l[l] = xs;
+        // Adhesion zone x* ≤ x ≤ aⱼ: p = (aⱼ − x)(A, B + C(aⱼ + x)).
+        let a2 = aj_ * aj_;
+        let cub = sl * (a2 + aj_ * xs + xs * xs) * (1.0 / 3.0); // (aⱼ³ − x*³)/3
+        let i0 = 0.5 * sl * sl; // ∫(aⱼ − x)
+        let i_par = sl * a2 - cub; // ∫(aⱼ² − x²)
+        let ix_lin = aj_ * sl * tstar * 0.5 - cub; // ∫x(aⱼ − x)
+        let ix_par = a2 * sl * tstar * 0.5 - sl * tstar * (a2 + xs * xs) * 0.25; // ∫x(aⱼ² − x²)
+        let afx = a_ * i0;
+        let afy = bb * i0 + cc * i_par;
+        let amz = bb * ix_lin + cc * ix_par - y_ * afx;
+        // Sliding zone −aⱼ ≤ x ≤ x*: direction d = (A, B' + C x) with
+        // B' = B + C aⱼ (the adhesion solution continued).
+        let ell = tstar;
+        let b2 = bb + cc * aj_;
+        let xm = 0.5 * (xs - aj_);
+        let u = b2 + cc * xm;
+        let w2 = a_ * a_ + u * u;
+        let turn = cc * ell;
+        let taylor = turn * turn <= 0.16 * w2;
+        let (tfx, tfy, tmz) = sliding_taylor(a_, y_, a2, xm, u, w2, cc, kk, ell);
+        let (tfx, tfy, tmz) = if taylor {
+            (tfx, tfy, tmz)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        closed[l] = !taylor && ell > 0.0;
+        sx[l] = afx + tfx;
+        sy[l] = afy + tfy;
+        sm[l] = amz + tmz;
+    }
+    for l in 0..chunk.len() {
+        if closed[l] {
+            let s = sliding_closed(
+                aj[l],
+                y[l],
+                aa[l],
+                bb + cc * aj[l],
+                cc,
+                inv_cc,
+                kk,
+                -aj[l],
+                xs_l[l],
+            );
+            sx[l] += s.fx;
+            sy[l] += s.fy;
+            sm[l] += s.mz;
+        }
+        fx += sx[l];
+        fy += sy[l];
+        mz += sm[l];
+    }
+    (fx, fy, mz)
 }
 
 /// Sliding zone of length `ell` centred at `xm` by a second-order Taylor
@@ -285,7 +341,7 @@ fn sliding_taylor(
 
 /// Sliding zone x1 ≤ x ≤ x2 with p = K(aj² − x²)·e, e = d/|d|, d = (A, B + 2Cx)
 /// (called with the adhesion-continuation direction: B = B' and 2C = C), in
-/// closed form; requires a direction that turns (2C ≠ 0).
+/// closed form; requires a direction that turns (2C ≠ 0); `inv2c` = 1/(2C).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn sliding_closed(
@@ -294,6 +350,7 @@ fn sliding_closed(
     aa: f64,
     bb: f64,
     two_c: f64,
+    inv2c: f64,
     kk: f64,
     x1: f64,
     x2: f64,
@@ -304,7 +361,6 @@ fn sliding_closed(
     let amin = 1e-12 * (bb.abs() + two_c.abs() * aj) + f64::MIN_POSITIVE.sqrt();
     let aeff = if aa.abs() < amin { amin } else { aa.abs() };
     let a2 = aeff * aeff;
-    let inv2c = 1.0 / two_c;
     let al2 = -inv2c * inv2c;
     let al1 = -2.0 * bb * al2;
     let al0 = a2j + bb * bb * al2;
@@ -358,7 +414,7 @@ mod tests {
                 let b2 = u - cc * xm;
                 let w2 = a_ * a_ + u * u;
                 let (tx, ty, tm) = sliding_taylor(a_, y, aj * aj, xm, u, w2, cc, kk, ell);
-                let c = sliding_closed(aj, y, a_, b2, cc, kk, -aj, xs);
+                let c = sliding_closed(aj, y, a_, b2, cc, 1.0 / cc, kk, -aj, xs);
                 let mag = c.fx.hypot(c.fy);
                 let e = (tx - c.fx).hypot(ty - c.fy) / mag;
                 worst = worst.max(e);
