@@ -117,7 +117,7 @@ pub(crate) fn validate(p: &ContactPatch, c: &Creepages) -> Result<KalkerCoeffici
     if !c.phi.is_finite() {
         return Err(bad("phi", c.phi, "finite, 1/m"));
     }
-    KalkerCoefficients::interpolate(p.a / p.b, p.nu).ok_or(bad("nu", p.nu, "in [0, 0.5]"))
+    KalkerCoefficients::interpolate_ab(p.a, p.b, p.nu).ok_or(bad("nu", p.nu, "in [0, 0.5]"))
 }
 
 /// Kalker's flexibilities of the simplified theory (FASTSIM), m/Pa:
@@ -134,10 +134,13 @@ pub(crate) struct Flexibilities {
 impl Flexibilities {
     #[inline]
     pub(crate) fn new(p: &ContactPatch, k: &KalkerCoefficients) -> Self {
+        // One division: 1/a; 1/(π a √(a/b)) = √(b/a)/(π a).
+        let inv_a = 1.0 / p.a;
+        let g_a = p.g * inv_a;
         Self {
-            inv_l1: 3.0 * k.c11 * p.g / (8.0 * p.a),
-            inv_l2: 3.0 * k.c22 * p.g / (8.0 * p.a),
-            inv_l3: 4.0 * k.c23 * p.g / (std::f64::consts::PI * p.a * (p.a / p.b).sqrt()),
+            inv_l1: 0.375 * k.c11 * g_a,
+            inv_l2: 0.375 * k.c22 * g_a,
+            inv_l3: 4.0 / std::f64::consts::PI * k.c23 * g_a * (p.b * inv_a).sqrt(),
         }
     }
 }

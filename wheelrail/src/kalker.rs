@@ -65,14 +65,24 @@ impl KalkerCoefficients {
     /// non-finite ratio or `nu` outside `[0, 0.5]`.
     #[inline]
     pub fn interpolate(a_over_b: f64, nu: f64) -> Option<Self> {
-        if !(a_over_b.is_finite() && a_over_b > 0.0 && (0.0..=0.5).contains(&nu)) {
+        if !(a_over_b.is_finite() && a_over_b > 0.0) {
+            return None;
+        }
+        Self::interpolate_ab(a_over_b, 1.0, nu)
+    }
+
+    /// As [`KalkerCoefficients::interpolate`] from the semi-axes `a`
+    /// (rolling direction) and `b` (positive, finite; one division).
+    #[inline]
+    pub fn interpolate_ab(a: f64, b: f64, nu: f64) -> Option<Self> {
+        if !(a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0 && (0.0..=0.5).contains(&nu)) {
             return None;
         }
         // Continuous table abscissa s in [0, 18].
-        let s = if a_over_b <= 1.0 {
-            10.0 * a_over_b - 1.0
+        let s = if a <= b {
+            10.0 * a / b - 1.0
         } else {
-            19.0 - 10.0 / a_over_b
+            19.0 - 10.0 * b / a
         };
         let s = s.clamp(0.0, 18.0);
         let i = (s as usize).min(17);

@@ -59,6 +59,8 @@ pub struct FastsimA {
     strip_geom: Vec<(f64, f64)>,
     /// Σ (4/3)(1 − η²)^(3/2)·Δη: the strips' bound integral for a = b = 1.
     norm: f64,
+    /// Strip width for b = 1: Δη = 2/m.
+    d_eta: f64,
 }
 
 /// Integrals over one strip (traction on the rail, before the sign flip).
@@ -85,7 +87,11 @@ impl FastsimA {
             })
             .collect();
         let norm = strip_geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
-        Ok(Self { strip_geom, norm })
+        Ok(Self {
+            strip_geom,
+            norm,
+            d_eta: 2.0 / mf,
+        })
     }
 
     /// Strips are processed in chunks of `LANES`: branch-free passes over the
@@ -95,7 +101,7 @@ impl FastsimA {
     /// turns much take the closed form (with a logarithm) in a last pass.
     #[inline]
     fn eval(&self, p: &ContactPatch, c: &Creepages, fl: &Flexibilities) -> CreepForces {
-        let dy = 2.0 * p.b / self.strip_geom.len() as f64;
+        let dy = self.d_eta * p.b;
         // Bound g = K(aⱼ² − x²) with K such that the strips carry exactly μN.
         let kk = p.mu * p.n / (self.norm * p.a * p.a * p.a * p.b);
         let bb = c.eta * fl.inv_l2;
