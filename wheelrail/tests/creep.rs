@@ -403,3 +403,53 @@ fn bad_input_is_named() {
     assert!(Fastsim::new(0, 10).is_err());
     assert!(FastsimA::new(0).is_err());
 }
+
+/// Robustness: extreme but valid inputs never give NaN or a force above μN
+/// (FASTSIM, FastSim_A, Mueller), and forces are finite for every law.
+#[test]
+fn extreme_inputs_stay_finite_and_bounded() {
+    let laws: Vec<Box<dyn CreepLaw>> = vec![
+        Box::new(KalkerLinear),
+        Box::new(Mueller::default()),
+        Box::new(Fastsim::new(7, 9).unwrap()),
+        Box::new(
+            Fastsim::new(7, 9)
+                .unwrap()
+                .with_bound(TractionBound::Elliptic),
+        ),
+        Box::new(FastsimA::new(1).unwrap()),
+        Box::new(FastsimA::new(13).unwrap()),
+    ];
+    let vals = [0.0, 1e-12, -3e-6, 1e-3, -0.05, 1.0];
+    for (a, b) in [(6e-3, 4e-3), (1e-4, 2e-2), (3e-2, 5e-4), (5e-3, 5e-3)] {
+        for n in [1.0, 1e5] {
+            let p = ContactPatch {
+                a,
+                b,
+                g: 8e10,
+                nu: 0.3,
+                mu: 0.4,
+                n,
+            };
+            for &xi in &vals {
+                for &eta in &vals {
+                    for phi in [0.0, 1e-9, -0.2, 5.0, -100.0] {
+                        let c = Creepages { xi, eta, phi };
+                        for law in &laws {
+                            let f = law.forces(&p, &c).unwrap();
+                            assert!(
+                                f.fx.is_finite() && f.fy.is_finite() && f.mz.is_finite(),
+                                "{}: {p:?} {c:?}: {f:?}",
+                                law.name()
+                            );
+                            if law.name() != "kalker" {
+                                let t = f.fx.hypot(f.fy);
+                                assert!(t <= p.mu * n * (1.0 + 1e-9), "{}: {t}", law.name());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
