@@ -61,7 +61,8 @@ impl ModelSystem {
             mass: true,
             bias: true,
             gravity: true,
-            kinematics: true,
+            // Body kinematics and Jacobians serve the force elements only.
+            kinematics: !forces.is_empty(),
             jacobians: !forces.is_empty(),
             constraints: false,
         };

@@ -1,0 +1,128 @@
+//! Plugin loading: a plugin is refused, with a clear message, when it was built
+//! from another model, for another ABI version, or is not a plugin at all; and a
+//! simulation gives the same trajectory with either engine.
+
+mod common;
+
+use common::*;
+use railmbs_runtime::integrate::ParkSettings;
+use railmbs_runtime::{ModelSystem, NumericEquations, Plugin, PluginError};
+use std::path::PathBuf;
+
+fn cache() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins")
+}
+
+fn build(model: &railmbs_models::Model, abi: u32) -> PathBuf {
+    railmbs_codegen::build_plugin(model, &railmbs_codegen::GenerateOptions::new(abi), Some(cache()))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .path
+}
+
+#[test]
+fn plugin_of_another_model_is_refused() {
+    let pendulum = mechanism("pendulum");
+    let path = build(&pendulum, railmbs_runtime::plugin::ABI_VERSION);
+    // Structural change: one more elementary transformation.
+    let mut changed = pendulum.clone();
+    changed.bodies[0].joint.push(railmbs_models::Elementary {
+        kind: railmbs_models::ElementaryKind::Translation(railmbs_models::Axis::Z),
+        motion: railmbs_models::Motion::Fixed(railmbs_models::Expr::Num(0.1)),
+    });
+    let err = Plugin::load_for(&path, &changed).unwrap_err();
+    assert!(matches!(err, PluginError::ModelMismatch { .. }), "{err}");
+    let msg = err.to_string();
+    assert!(msg.contains("another model") && msg.contains("umgen"), "{msg}");
+    // A different default value is not a structural change: accepted.
+    let mut other_default = pendulum.clone();
+    other_default.parameters[0].default = railmbs_models::Expr::Num(2.0);
+    Plugin::load_for(&path, &other_default).unwrap();
+    // A different model entirely.
+    let err = Plugin::load_for(&path, &mechanism("double_pendulum")).unwrap_err();
+    assert!(err.to_string().contains("\"pendulum\""), "{err}");
+}
+
+#[test]
+fn plugin_of_another_abi_version_is_refused() {
+    let model = mechanism("pendulum");
+    let path = build(&model, railmbs_runtime::plugin::ABI_VERSION + 100);
+    let err = Plugin::load_for(&path, &model).unwrap_err();
+    assert!(matches!(err, PluginError::AbiVersion { .. }), "{err}");
+    assert!(err.to_string().contains("ABI version"), "{err}");
+}
+
+#[test]
+fn a_file_that_is_not_a_plugin_is_refused() {
+    let model = mechanism("pendulum");
+    let dir = tempfile::tempdir().unwrap();
+    let text = dir.path().join("not_a_library.so");
+    std::fs::write(&text, "this is text").unwrap();
+    let err = Plugin::load_for(&text, &model).unwrap_err();
+    assert!(matches!(err, PluginError::NotALibrary { .. }), "{err}");
+    assert!(err.to_string().contains("not_a_library.so"), "{err}");
+    // A real shared library without the plugin's symbols.
+    let lib = railmbs_build_support::build_plugin(
+        "#[no_mangle] pub extern \"C\" fn something_else() -> i32 { 1 }",
+        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(cache()),
+    )
+    .unwrap();
+    let err = Plugin::load_for(&lib.path, &model).unwrap_err();
+    assert!(matches!(err, PluginError::MissingSymbol { .. }), "{err}");
+    assert!(err.to_string().contains("railmbs_plugin_info"), "{err}");
+}
+
+#[test]
+fn fixed_parameters_are_folded_and_other_values_refused() {
+    let model = mechanism("pendulum");
+    let mut opts = railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
+    opts.fixed = vec!["l".into(), "r".into()];
+    let built = railmbs_codegen::build_plugin(&model, &opts, Some(cache())).unwrap();
+    let plugin = Plugin::load_for(&built.path, &model).unwrap();
+    let mut eq = railmbs_runtime::PluginEquations::new(plugin);
+    let mut params = model.default_parameter_values();
+    use railmbs_runtime::Equations;
+    eq.set_parameters(&params).unwrap();
+    params[model.parameter_index("l").unwrap()] = 2.0;
+    let err = eq.set_parameters(&params).unwrap_err().to_string();
+    assert!(err.contains("\"l\"") && err.contains("fixed"), "{err}");
+    let err = railmbs_codegen::build_plugin(
+        &model,
+        &railmbs_codegen::GenerateOptions { fixed: vec!["nope".into()], ..opts },
+        Some(cache()),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("nope"), "{err}");
+}
+
+#[test]
+fn symbolic_and_numeric_engines_give_the_same_trajectories() {
+    for name in ["double_pendulum", "fourbar", "spring_mass", "shaken_pendulum", "chain10"] {
+        let model = mechanism(name);
+        let params = model.default_parameter_values();
+        let (q0, v0) = model.initial_state(&params);
+        let mut num = ModelSystem::new(&model, Box::new(NumericEquations::new(&model)), params.clone()).unwrap();
+        let mut sym = ModelSystem::new(&model, Box::new(symbolic_engine(&model)), params.clone()).unwrap();
+        // Fixed step: the engines differ only by rounding, so the states agree
+        // to far below any integration error.
+        let fixed = ParkSettings::fixed(1e-3);
+        let (a, _) = run_park(&mut num, &fixed, &q0, &v0, 2.0);
+        let (b, _) = run_park(&mut sym, &fixed, &q0, &v0, 2.0);
+        for ((ta, qa, _), (tb, qb, _)) in a.iter().zip(&b) {
+            assert_eq!(ta, tb);
+            for (x, y) in qa.iter().zip(qb) {
+                assert!((x - y).abs() < 1e-9 * (1.0 + x.abs()), "{name}, t = {ta}: {x} vs {y}");
+            }
+        }
+        // Error control may pick a different step now and then (a rounding-level
+        // difference in the error estimate near the acceptance threshold): the
+        // end states then agree to the size of the integration error.
+        let adaptive = ParkSettings::with_tolerances(1e-8, 1e-8);
+        let (a, _) = run_park(&mut num, &adaptive, &q0, &v0, 2.0);
+        let (b, _) = run_park(&mut sym, &adaptive, &q0, &v0, 2.0);
+        let (qa, qb) = (&a.last().unwrap().1, &b.last().unwrap().1);
+        for (x, y) in qa.iter().zip(qb) {
+            assert!((x - y).abs() < 1e-5 * (1.0 + x.abs()), "{name}: {x} vs {y}");
+        }
+    }
+}
