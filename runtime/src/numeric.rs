@@ -168,9 +168,8 @@ pub struct NumericEquations {
     composite_center: Vec<Vector3<f64>>,
     composite_inertia: Vec<Matrix3<f64>>,
     /// Motion vector of each coordinate about its tree's root point o:
-    /// angular part (u or 0) and linear part ((p − o) × u or u).
-    motion_angular: Vec<Vector3<f64>>,
-    motion_linear: Vec<Vector3<f64>>,
+    /// angular part (u or 0) then linear part ((p − o) × u or u).
+    motion: Vec<[f64; 6]>,
     /// Subtree wrenches of the backward pass: force (N), moment about the
     /// body's centre of mass (N m).
     subtree_force: Vec<Vector3<f64>>,
@@ -394,8 +393,7 @@ impl NumericEquations {
             composite_mass: vec![0.0; nb],
             composite_center: vec![Vector3::zeros(); nb],
             composite_inertia: vec![Matrix3::zeros(); nb],
-            motion_angular: vec![Vector3::zeros(); n],
-            motion_linear: vec![Vector3::zeros(); n],
+            motion: vec![[0.0; 6]; n],
             subtree_force: vec![Vector3::zeros(); nb],
             subtree_moment: vec![Vector3::zeros(); nb],
         }
@@ -490,19 +488,31 @@ impl NumericEquations {
         };
         for j in 0..self.bodies.len() {
             let body = &self.bodies[j];
-            let mut s = match body.parent {
-                Some(p) => self.states[p],
-                None => root_state,
+            // Start from the parent's frame, in place (field by field: no
+            // memcpy call for the whole state).
+            let (done, rest) = self.states.split_at_mut(j);
+            let s = &mut rest[0];
+            let from = match body.parent {
+                Some(p) => &done[p],
+                None => &root_state,
             };
+            s.r = from.r;
+            s.a = from.a;
+            s.v = from.v;
+            s.w = from.w;
+            if with_acc {
+                s.acc0 = from.acc0;
+                s.alpha0 = from.alpha0;
+            }
             for step in &self.steps[body.steps.0..body.steps.1] {
                 match *step {
                     Step::AxisShift { axis, value } => {
                         let d = s.a.column(axis) * value;
-                        translate(&mut s, &d, None, with_acc);
+                        translate(s, &d, None, with_acc);
                     }
                     Step::Shift { d } => {
                         let d = s.a * d;
-                        translate(&mut s, &d, None, with_acc);
+                        translate(s, &d, None, with_acc);
                     }
                     Step::Turn { r } => s.a *= r,
                     Step::CoordRotation { axis, coord } => {
@@ -512,7 +522,7 @@ impl NumericEquations {
                             u,
                             p: s.r,
                         };
-                        rotate(&mut s, axis, &u, q[coord], qd[coord], 0.0, with_acc);
+                        rotate(s, axis, &u, q[coord], qd[coord], 0.0, with_acc);
                     }
                     Step::CoordTranslation { axis, coord } => {
                         let u = s.a.column(axis).into_owned();
@@ -523,7 +533,7 @@ impl NumericEquations {
                         };
                         let d = u * q[coord];
                         let v_rel = u * qd[coord];
-                        translate(&mut s, &d, Some((&v_rel, &Vector3::zeros())), with_acc);
+                        translate(s, &d, Some((&v_rel, &Vector3::zeros())), with_acc);
                     }
                     Step::Time {
                         rotation,
@@ -536,19 +546,18 @@ impl NumericEquations {
                         let acc = m.acceleration.eval(&self.params, t);
                         let u = s.a.column(axis).into_owned();
                         if rotation {
-                            rotate(&mut s, axis, &u, val, rate, acc, with_acc);
+                            rotate(s, axis, &u, val, rate, acc, with_acc);
                         } else {
                             let d = u * val;
                             let v_rel = u * rate;
                             let a_rel = u * acc;
-                            translate(&mut s, &d, Some((&v_rel, &a_rel)), with_acc);
+                            translate(s, &d, Some((&v_rel, &a_rel)), with_acc);
                         }
                     }
                 }
             }
-            self.states[j] = s;
             if with_inertia {
-                self.inertia_global[j] = s.a * body.inertia * s.a.transpose();
+                self.inertia_global[j] = rotate_tensor(&s.a, &body.inertia);
             }
         }
     }
@@ -616,16 +625,22 @@ impl NumericEquations {
         }
         // Motion vectors of the coordinates about their tree's root point o
         // (a point of the mechanism, so no digits are lost far from SC0).
-        for (k, ax) in self.axes.iter().enumerate() {
-            let o = self.states[self.bodies[self.coordinate_body[k]].root].r;
-            if ax.rotation {
-                self.motion_angular[k] = ax.u;
-                self.motion_linear[k] = (ax.p - o).cross(&ax.u);
+        for ((m, ax), &body) in self
+            .motion
+            .iter_mut()
+            .zip(&self.axes)
+            .zip(&self.coordinate_body)
+        {
+            let o = self.states[self.bodies[body].root].r;
+            let (a, b) = if ax.rotation {
+                (ax.u, (ax.p - o).cross(&ax.u))
             } else {
-                self.motion_angular[k] = Vector3::zeros();
-                self.motion_linear[k] = ax.u;
-            }
+                (Vector3::zeros(), ax.u)
+            };
+            *m = [a.x, a.y, a.z, b.x, b.y, b.z];
         }
+        let n = mass.nrows();
+        let ms = mass.as_mut_slice(); // column-major: (r, c) at r + c n
         for (b, body) in self.bodies.iter().enumerate() {
             let o = self.states[body.root].r;
             let cm = self.composite_mass[b];
@@ -642,12 +657,17 @@ impl NumericEquations {
                     (cm * ax.u, Vector3::zeros())
                 };
                 let h = ang + (cc - o).cross(&lin);
+                let f = [h.x, h.y, h.z, lin.x, lin.y, lin.z];
                 // M_ik = S_k · (h, lin): the generalized force of the momentum
                 // on coordinate k, u_k·(h − (p_k − o)×lin) for a rotation.
                 for &k in &body.chain[..=pos] {
-                    let value = self.motion_angular[k].dot(&h) + self.motion_linear[k].dot(&lin);
-                    mass[(i, k)] = value;
-                    mass[(k, i)] = value;
+                    let m = &self.motion[k];
+                    let value = m[0] * f[0]
+                        + m[1] * f[1]
+                        + m[2] * f[2]
+                        + (m[3] * f[3] + m[4] * f[4] + m[5] * f[5]);
+                    ms[k + i * n] = value;
+                    ms[i + k * n] = value;
                 }
             }
         }
@@ -818,6 +838,17 @@ fn steiner(m: f64, d: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(yy + zz, -xy, -xz, -xy, xx + zz, -yz, -xz, -yz, xx + yy)
 }
 
+/// A I Aᵀ for a symmetric I: B = A I, then the six distinct entries of B Aᵀ.
+#[inline(always)]
+fn rotate_tensor(a: &Matrix3<f64>, i: &Matrix3<f64>) -> Matrix3<f64> {
+    let b = a * i;
+    let e =
+        |r: usize, c: usize| b[(r, 0)] * a[(c, 0)] + b[(r, 1)] * a[(c, 1)] + b[(r, 2)] * a[(c, 2)];
+    let (xx, yy, zz) = (e(0, 0), e(1, 1), e(2, 2));
+    let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+}
+
 impl Equations for NumericEquations {
     fn engine_name(&self) -> &str {
         "numeric"
@@ -903,12 +934,16 @@ impl Equations for NumericEquations {
         self.forward(t, q, v, parts.bias, parts.mass || parts.bias);
         if parts.kinematics {
             for (k, s) in out.bodies.iter_mut().zip(&self.states) {
-                *k = BodyKinematics {
-                    position: s.r,
-                    rotation: s.a,
-                    velocity: s.v,
-                    angular_velocity: s.w,
-                };
+                let BodyKinematics {
+                    position,
+                    rotation,
+                    velocity,
+                    angular_velocity,
+                } = k;
+                *position = s.r;
+                *rotation = s.a;
+                *velocity = s.v;
+                *angular_velocity = s.w;
             }
         }
         if parts.mass {
@@ -933,7 +968,17 @@ impl Equations for NumericEquations {
             );
             self.project_subtree_wrenches(&mut out.bias);
         }
-        if parts.gravity {
+        if parts.gravity && parts.mass {
+            // The composite bodies of M give Q_g directly: the weight m_c g of
+            // each subtree acts at its centre of mass c.
+            for (b, body) in self.bodies.iter().enumerate() {
+                let weight = self.composite_mass[b] * self.gravity;
+                let c = &self.composite_center[b];
+                for &i in &body.chain[body.own_start..] {
+                    out.gravity[i] = self.project_wrench(i, &weight, &Vector3::zeros(), c);
+                }
+            }
+        } else if parts.gravity {
             let (bodies, g) = (&self.bodies, self.gravity);
             accumulate_wrenches(
                 &self.states,
