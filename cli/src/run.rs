@@ -95,6 +95,8 @@ fn print_summary(s: &RunSummary, output: Option<&std::path::Path>) {
     }
     match output {
         Some(p) => println!("output                 {} ({} rows)", p.display(), s.rows),
-        None => println!("output                 none (give -o FILE or output_file in the scenario)"),
+        None => {
+            println!("output                 none (give -o FILE or output_file in the scenario)")
+        }
     }
 }

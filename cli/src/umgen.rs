@@ -59,12 +59,20 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         None => built.path.clone(),
     };
     let s = &g.stats;
-    println!("model                  {} ({})", model.name, args.model.display());
+    println!(
+        "model                  {} ({})",
+        model.name,
+        args.model.display()
+    );
     println!(
         "size                   {} coordinates, {} bodies, {} constraints, {} parameters ({} fixed)",
         model.coordinates.len(),
         model.bodies.len(),
-        model.cut_joints.iter().map(|c| c.constrained.len()).sum::<usize>(),
+        model
+            .cut_joints
+            .iter()
+            .map(|c| c.constrained.len())
+            .sum::<usize>(),
         model.parameters.len(),
         args.fixed.len()
     );
@@ -82,10 +90,16 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         "generated source       {} lines in {} functions",
         s.source_lines, s.functions
     );
-    println!("derivation time        {:.4} s", g.derive_time.as_secs_f64());
+    println!(
+        "derivation time        {:.4} s",
+        g.derive_time.as_secs_f64()
+    );
     println!("CSE and emission time  {:.4} s", g.emit_time.as_secs_f64());
     match built.compile_time {
-        Some(t) => println!("compile time           {:.3} s (cache miss)", t.as_secs_f64()),
+        Some(t) => println!(
+            "compile time           {:.3} s (cache miss)",
+            t.as_secs_f64()
+        ),
         None => println!("compile time           0 s (cache hit)"),
     }
     println!("plugin                 {}", target.display());

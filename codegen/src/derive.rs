@@ -16,9 +16,7 @@
 //! M_ij = u_j·(H + (r_b − p_j) × L) for a rotation j and u_j·L for a translation.
 
 use railmbs_cas::{Context, ExprId, Symbol};
-use railmbs_models::{
-    BodyRef, Component, ElementaryKind, Expr, Frame, Func, Model, Motion,
-};
+use railmbs_models::{BodyRef, Component, ElementaryKind, Expr, Frame, Func, Model, Motion};
 
 /// A 3-vector of expressions.
 pub type V3 = [ExprId; 3];
@@ -219,8 +217,8 @@ pub fn expr_to_cas(ctx: &mut Context, e: &Expr, opts: &DeriveOptions) -> ExprId 
             let y = expr_to_cas(ctx, b, opts);
             match ctx.as_num(y) {
                 Some(n) if n.fract() == 0.0 && n.abs() <= 64.0 => ctx.powi(x, n as i32),
-                Some(n) if n == 0.5 => ctx.sqrt(x),
-                Some(n) if n == -0.5 => {
+                Some(0.5) => ctx.sqrt(x),
+                Some(-0.5) => {
                     let s = ctx.sqrt(x);
                     ctx.recip(s)
                 }
@@ -348,10 +346,18 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                 _ => None,
             };
             if let Some(i) = coord {
-                axes[i] = Some(AxisInfo { rotation, u, p: s.r });
+                axes[i] = Some(AxisInfo {
+                    rotation,
+                    u,
+                    p: s.r,
+                });
                 op_of[i] = ops.len();
             }
-            let d_op = if rotation { None } else { Some(alg.scale(val, u)) };
+            let d_op = if rotation {
+                None
+            } else {
+                Some(alg.scale(val, u))
+            };
             ops.push(OpNode {
                 parent: last_op,
                 d: d_op,
@@ -386,7 +392,11 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         }
         let m = expr_to_cas(alg.ctx, &body.mass, opts);
         let iv = body.inertia.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
-        let ib = [[iv[0], iv[3], iv[4]], [iv[3], iv[1], iv[5]], [iv[4], iv[5], iv[2]]];
+        let ib = [
+            [iv[0], iv[3], iv[4]],
+            [iv[3], iv[1], iv[5]],
+            [iv[4], iv[5], iv[2]],
+        ];
         inertia_g.push(alg.rotate_tensor(&s.a, &ib));
         masses.push(m);
         states.push(s);
@@ -413,7 +423,9 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         BodyRef::Body(p) => body_end[p],
     };
     // r_c − r_parent(c) for every body.
-    let seg_body: Vec<V3> = (0..nb).map(|c| sum_d(&mut alg, body_end[c], parent_end(c))).collect();
+    let seg_body: Vec<V3> = (0..nb)
+        .map(|c| sum_d(&mut alg, body_end[c], parent_end(c)))
+        .collect();
     // r_b − p_i for every coordinate i of body b.
     let mut to_com: Vec<V3> = vec![alg.v_zero(); n];
     let mut coord_body = vec![0usize; n];
@@ -436,12 +448,12 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
     // p_i − p_prev(i) for consecutive coordinates on a chain (prev = the
     // coordinate before i on the path from SC0).
     let mut seg_coord: Vec<V3> = vec![alg.v_zero(); n];
-    for b in 0..nb {
-        for (pos, &i) in chains[b].iter().enumerate() {
+    for (b, chain) in chains.iter().enumerate() {
+        for (pos, &i) in chain.iter().enumerate() {
             if pos == 0 || coord_body[i] != b {
                 continue;
             }
-            let prev = chains[b][pos - 1];
+            let prev = chain[pos - 1];
             seg_coord[i] = sum_d(&mut alg, ops[op_of[i]].parent, ops[op_of[prev]].parent);
         }
     }
@@ -513,7 +525,10 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             // About p_i.
             let dl = alg.cross(d, l);
             let mut h = alg.add(h_com, dl);
-            let pos_i = chain.iter().position(|&c| c == i).expect("own coordinate in chain");
+            let pos_i = chain
+                .iter()
+                .position(|&c| c == i)
+                .expect("own coordinate in chain");
             for pos in (0..=pos_i).rev() {
                 let k = chain[pos];
                 if pos < pos_i {
@@ -523,7 +538,11 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                     h = alg.add(h, sl);
                 }
                 let axk = axes[k].expect("coordinate axis set");
-                let value = if axk.rotation { alg.dot(axk.u, h) } else { alg.dot(axk.u, l) };
+                let value = if axk.rotation {
+                    alg.dot(axk.u, h)
+                } else {
+                    alg.dot(axk.u, l)
+                };
                 mass_entries.push(((k, i), value));
             }
         }
@@ -570,7 +589,9 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         let wiw = alg.cross(s.w, iw);
         (f, alg.add(ia, wiw))
     });
-    let gravity_q = project(&mut alg, &|alg, j| (alg.scale(masses[j], gravity), alg.v_zero()));
+    let gravity_q = project(&mut alg, &|alg, j| {
+        (alg.scale(masses[j], gravity), alg.v_zero())
+    });
 
     // Kinematics and Jacobians.
     let mut kinematics = Vec::with_capacity(18 * nb);
@@ -607,7 +628,10 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
     for cut in &model.cut_joints {
         let frame_pose = |alg: &mut Alg, body: BodyRef, f: &Frame| -> (V3, M3, Option<usize>) {
             let o = f.origin.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
-            let ang = f.rotation_xyz.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
+            let ang = f
+                .rotation_xyz
+                .clone()
+                .map(|e| expr_to_cas(alg.ctx, &e, opts));
             let rx = alg.rotation(0, ang[0]);
             let ry = alg.rotation(1, ang[1]);
             let rz = alg.rotation(2, ang[2]);

@@ -12,8 +12,8 @@
 use crate::derive::Derived;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
-use railmbs_cas::{Instr, Operand, OpCounts, Program, SymbolKind};
 use railmbs_cas::Func as CasFunc;
+use railmbs_cas::{Instr, OpCounts, Operand, Program, SymbolKind};
 
 /// Where one program output goes: buffer and flat index (column-major for
 /// matrices); a mass entry off the diagonal goes to both triangles.
@@ -119,7 +119,11 @@ pub(crate) fn units(d: &Derived) -> Vec<Unit> {
             out.push(*e);
             t.push(Target::Constraint(i));
         }
-        for (e, &(r, c)) in d.constraint_jacobian.iter().zip(&d.constraint_jacobian_index) {
+        for (e, &(r, c)) in d
+            .constraint_jacobian
+            .iter()
+            .zip(&d.constraint_jacobian_index)
+        {
             out.push(*e);
             t.push(Target::ConstraintJacobian(c * nc + r));
         }
@@ -302,17 +306,23 @@ fn emit_unit(
             let s = s as usize;
             quote!(let #id = s[#s];)
         });
-        let body = chunk.instrs.clone().filter(|k| !fused_skip.contains(k)).map(|k| {
-            if let Some(&(si, cj)) = fused_first.get(&k) {
-                let (sid, cid) = (format_ident!("t{}", si), format_ident!("t{}", cj));
-                let Instr::Call(_, a) = prog.instrs[k] else { unreachable!("sin/cos pair") };
-                let a = operand(a, &local);
-                return quote!(let (#sid, #cid) = f64::sin_cos(#a););
-            }
-            let id = format_ident!("t{}", k);
-            let e = instr(&prog.instrs[k], &local);
-            quote!(let #id = #e;)
-        });
+        let body = chunk
+            .instrs
+            .clone()
+            .filter(|k| !fused_skip.contains(k))
+            .map(|k| {
+                if let Some(&(si, cj)) = fused_first.get(&k) {
+                    let (sid, cid) = (format_ident!("t{}", si), format_ident!("t{}", cj));
+                    let Instr::Call(_, a) = prog.instrs[k] else {
+                        unreachable!("sin/cos pair")
+                    };
+                    let a = operand(a, &local);
+                    return quote!(let (#sid, #cid) = f64::sin_cos(#a););
+                }
+                let id = format_ident!("t{}", k);
+                let e = instr(&prog.instrs[k], &local);
+                quote!(let #id = #e;)
+            });
         let stores = chunk.stores.iter().map(|&(t, s)| {
             let id = format_ident!("t{}", t);
             let s = s as usize;
@@ -427,7 +437,9 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     stats.functions = functions;
     let has_con = nc > 0;
     let con_call = if has_con {
-        quote!(if parts & PART_CONSTRAINTS != 0 { eval_con(t, q, v, p, u, &mut o); })
+        quote!(if parts & PART_CONSTRAINTS != 0 {
+            eval_con(t, q, v, p, u, &mut o);
+        })
     } else {
         quote!()
     };
@@ -437,10 +449,14 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let coords = c_string_list(&header.coordinate_names);
     let params = c_string_list(&header.parameter_names);
     let nfixed = header.fixed.len();
-    let fixed_idx: Vec<TokenStream> = header.fixed.iter().map(|&(i, _)| {
-        let i = i as u32;
-        quote!(#i)
-    }).collect();
+    let fixed_idx: Vec<TokenStream> = header
+        .fixed
+        .iter()
+        .map(|&(i, _)| {
+            let i = i as u32;
+            quote!(#i)
+        })
+        .collect();
     let fixed_val: Vec<TokenStream> = header.fixed.iter().map(|&(_, x)| lit(x)).collect();
     let (mass_len, bias_len, kin_len, jac_len, con_len, cjac_len) =
         (n * n, n, 18 * nb, 6 * nb * n, nc, nc * n);

@@ -13,7 +13,7 @@
 pub mod derive;
 pub mod emit;
 
-pub use derive::{derive, DeriveOptions, Derived};
+pub use derive::{DeriveOptions, Derived, derive};
 pub use emit::{EmitStats, PluginHeader};
 
 use railmbs_build_support::{BuildError, BuildOptions};

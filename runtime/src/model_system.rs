@@ -3,7 +3,7 @@
 //! [`MechanicalSystem`].
 
 use crate::equations::{Equations, Evaluation, Parts};
-use crate::forces::{self, ForceContext, ForceElement, Wrench};
+use crate::forces::{self, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Wrench};
 use crate::system::{MechanicalSystem, SimError};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
@@ -16,6 +16,7 @@ pub struct ModelSystem {
     eval: Evaluation,
     wrenches: Vec<Wrench>,
     dynamics_parts: Parts,
+    jacobian_scratch: JacobianScratch,
     recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
 }
 
@@ -73,6 +74,7 @@ impl ModelSystem {
             eval,
             wrenches: vec![Wrench::default(); nb],
             dynamics_parts,
+            jacobian_scratch: JacobianScratch::new(model.coordinates.len()),
             recorder: None,
         })
     }
@@ -207,6 +209,52 @@ impl MechanicalSystem for ModelSystem {
         g.copy_from(&self.eval.constraints);
         jacobian.copy_from(&self.eval.constraint_jacobian);
         Ok(())
+    }
+
+    /// The approximate analytic Jacobian of the paper's Sect. 6 (Eq. 31):
+    /// ∂f/∂q ≈ Σ_elements Gᵀ C_loc G and ∂f/∂q̇ ≈ Σ Gᵀ D_loc G from the force
+    /// elements' local Jacobians ([`ForceElement::add_jacobian`]); the
+    /// derivatives of the inertia, gyroscopic and gravity terms and of the
+    /// body Jacobians are neglected. Systems without force elements return
+    /// `Ok(false)` (the integrator then differentiates numerically).
+    fn force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut DMatrix<f64>,
+        dfdv: &mut DMatrix<f64>,
+    ) -> Result<bool, SimError> {
+        if self.forces.is_empty() {
+            return Ok(false);
+        }
+        let parts = Parts {
+            mass: false,
+            bias: false,
+            gravity: false,
+            kinematics: true,
+            jacobians: true,
+            constraints: false,
+        };
+        self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
+        dfdq.fill(0.0);
+        dfdv.fill(0.0);
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+        };
+        let mut jac = ForceJacobian::new(
+            &self.eval.jacobians,
+            &self.eval.bodies,
+            dfdq,
+            dfdv,
+            &mut self.jacobian_scratch,
+        );
+        for f in &self.forces {
+            f.add_jacobian(&ctx, &mut jac)?;
+        }
+        Ok(true)
     }
 
     fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {

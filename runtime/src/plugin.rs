@@ -154,10 +154,11 @@ impl Plugin {
         // SAFETY: loading runs the library's initializers; railmbs plugins have
         // none beyond the Rust runtime's. Any library can be named here, which is
         // why the symbols and versions are checked before use.
-        let lib = unsafe { libloading::Library::new(path) }.map_err(|e| PluginError::NotALibrary {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+        let lib =
+            unsafe { libloading::Library::new(path) }.map_err(|e| PluginError::NotALibrary {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            })?;
         let lib: &'static libloading::Library = Box::leak(Box::new(lib));
         let missing = |symbol: &str| PluginError::MissingSymbol {
             path: path.to_path_buf(),
@@ -291,7 +292,12 @@ impl Equations for PluginEquations {
         }
         for &(i, value) in &self.plugin.fixed {
             if params[i] != value {
-                let name = self.plugin.parameter_names.get(i).cloned().unwrap_or_default();
+                let name = self
+                    .plugin
+                    .parameter_names
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_default();
                 return Err(SimError::Other(format!(
                     "parameter \"{name}\" was fixed at {value} when the plugin {} was generated, \
                      but the run asks for {}; regenerate without `--fixed {name}`",

@@ -3,11 +3,11 @@
 //! written as CSV while the run goes on (a run that stops early keeps what it
 //! has written).
 
+use crate::Equations;
 use crate::equations::Parts;
 use crate::integrate::{self, IntegrationStats, ParkSettings, Rk4Settings};
 use crate::model_system::ModelSystem;
 use crate::system::SimError;
-use crate::Equations;
 use nalgebra::{Matrix3, Vector3};
 use railmbs_models::{IntegratorSpec, JacobianKind, Model, OutputSpec, Scenario};
 use std::io::Write;
@@ -56,12 +56,20 @@ impl RunSummary {
     }
 }
 
+/// Parameter values and initial state of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    /// In `Model::parameters` order.
+    pub params: Vec<f64>,
+    /// Generalized coordinates (m, rad).
+    pub q: Vec<f64>,
+    /// Generalized velocities (m/s, rad/s).
+    pub v: Vec<f64>,
+}
+
 /// The parameter values and initial state a scenario asks for (errors name the
 /// scenario file, with line and column).
-pub fn scenario_state(
-    scenario: &Scenario,
-    model: &Model,
-) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), RunError> {
+pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState, RunError> {
     let setup = |message: String| RunError::Setup {
         file: scenario.source.clone(),
         message,
@@ -78,7 +86,7 @@ pub fn scenario_state(
             model.name
         )));
     }
-    Ok((params, q, v))
+    Ok(InitialState { params, q, v })
 }
 
 /// Column layout of the output file.
@@ -92,22 +100,35 @@ struct Columns {
     need_kinematics: bool,
 }
 
-fn select(names: &[String], wanted: &[String], what: &str, file: &Path) -> Result<Vec<usize>, RunError> {
+fn select(
+    names: &[String],
+    wanted: &[String],
+    what: &str,
+    file: &Path,
+) -> Result<Vec<usize>, RunError> {
     if wanted.iter().any(|w| w == "*") {
         return Ok((0..names.len()).collect());
     }
     wanted
         .iter()
         .map(|w| {
-            names.iter().position(|n| n == w).ok_or_else(|| RunError::Setup {
-                file: file.to_path_buf(),
-                message: format!("output: no {what} named \"{w}\""),
-            })
+            names
+                .iter()
+                .position(|n| n == w)
+                .ok_or_else(|| RunError::Setup {
+                    file: file.to_path_buf(),
+                    message: format!("output: no {what} named \"{w}\""),
+                })
         })
         .collect()
 }
 
-fn columns(model: &Model, system: &ModelSystem, spec: &OutputSpec, file: &Path) -> Result<Columns, RunError> {
+fn columns(
+    model: &Model,
+    system: &ModelSystem,
+    spec: &OutputSpec,
+    file: &Path,
+) -> Result<Columns, RunError> {
     let mut header = vec!["time".to_string()];
     if spec.coordinates {
         header.extend(model.coordinates.iter().map(|c| c.name.clone()));
@@ -120,8 +141,18 @@ fn columns(model: &Model, system: &ModelSystem, spec: &OutputSpec, file: &Path) 
     for &b in &bodies {
         let n = &body_names[b];
         for s in [
-            "x[m]", "y[m]", "z[m]", "rx[rad]", "ry[rad]", "rz[rad]", "vx[m/s]", "vy[m/s]", "vz[m/s]",
-            "wx[rad/s]", "wy[rad/s]", "wz[rad/s]",
+            "x[m]",
+            "y[m]",
+            "z[m]",
+            "rx[rad]",
+            "ry[rad]",
+            "rz[rad]",
+            "vx[m/s]",
+            "vy[m/s]",
+            "vz[m/s]",
+            "wx[rad/s]",
+            "wy[rad/s]",
+            "wz[rad/s]",
         ] {
             header.push(format!("{n}.{s}"));
         }
@@ -160,6 +191,9 @@ pub fn xyz_angles(a: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(x, b, z)
 }
 
+/// Time, coordinates, velocities and accelerations at the end of a step.
+type StepEnd = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// Cubic Hermite interpolation on [t0, t1] from values and derivatives.
 fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f64) -> f64 {
     let h = t1 - t0;
@@ -185,9 +219,15 @@ fn run_integrator(
     observer: impl FnMut(f64, &[f64], &[f64], &[f64]) -> ControlFlow<()>,
 ) -> Result<IntegrationStats, SimError> {
     match spec {
-        IntegratorSpec::Rk4 { step } => {
-            integrate::integrate_rk4(system, &Rk4Settings::new(*step), 0.0, q0, v0, t_end, observer)
-        }
+        IntegratorSpec::Rk4 { step } => integrate::integrate_rk4(
+            system,
+            &Rk4Settings::new(*step),
+            0.0,
+            q0,
+            v0,
+            t_end,
+            observer,
+        ),
         IntegratorSpec::Park {
             rtol,
             atol,
@@ -234,7 +274,13 @@ impl Recorder {
         }
     }
 
-    fn write_row(&mut self, system: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> Result<(), RunError> {
+    fn write_row(
+        &mut self,
+        system: &mut ModelSystem,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<(), RunError> {
         let cols = &self.columns;
         self.values.clear();
         self.values.push(t);
@@ -289,7 +335,11 @@ pub fn run_scenario(
     output: Option<&Path>,
     mut progress: impl FnMut(f64),
 ) -> Result<RunSummary, RunError> {
-    let (params, q0, v0) = scenario_state(scenario, model)?;
+    let InitialState {
+        params,
+        q: q0,
+        v: v0,
+    } = scenario_state(scenario, model)?;
     let engine = equations.engine_name().to_string();
     let mut system = ModelSystem::new(model, equations, params)?;
     let columns = columns(model, &system, &scenario.output, &scenario.source)?;
@@ -328,7 +378,8 @@ pub fn run_scenario(
     let t_end = scenario.end_time;
     let interval = scenario.output.interval;
     let n = q0.len();
-    let mut prev: Option<(f64, Vec<f64>, Vec<f64>, Vec<f64>)> = None;
+    // The previous accepted step's end (t, q, q̇, q̈), for Hermite interpolation.
+    let mut prev: Option<StepEnd> = None;
     let mut next_row = 0usize;
     let mut last_progress = Instant::now();
     let start = Instant::now();
@@ -350,8 +401,12 @@ pub fn run_scenario(
             }
             let (qi, vi) = match &prev {
                 Some((t0, q0, v0, a0)) if to < t => (
-                    (0..n).map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i])).collect(),
-                    (0..n).map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i])).collect(),
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
+                        .collect(),
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
+                        .collect(),
                 ),
                 _ => (q.to_vec(), v.to_vec()),
             };

@@ -30,7 +30,10 @@ fn downward_crossings(steps: &[(f64, Vec<f64>, Vec<f64>)], i: usize) -> Vec<f64>
             let h = t1 - t0;
             let f = |s: f64| {
                 let (s2, s3) = (s * s, s * s * s);
-                (2.0 * s3 - 3.0 * s2 + 1.0) * q0 + (s3 - 2.0 * s2 + s) * h * v0 + (-2.0 * s3 + 3.0 * s2) * q1 + (s3 - s2) * h * v1
+                (2.0 * s3 - 3.0 * s2 + 1.0) * q0
+                    + (s3 - 2.0 * s2 + s) * h * v0
+                    + (-2.0 * s3 + 3.0 * s2) * q1
+                    + (s3 - s2) * h * v1
             };
             let (mut a, mut b) = (0.0, 1.0);
             for _ in 0..60 {
@@ -63,7 +66,10 @@ fn pendulum_period(phi0: f64) -> (f64, f64) {
         (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64
     };
     let (p_rk, p_park) = (period(&rk), period(&park));
-    assert!(((p_park - exact) / exact).abs() < 1e-6, "Park: period {p_park}, exact {exact}");
+    assert!(
+        ((p_park - exact) / exact).abs() < 1e-6,
+        "Park: period {p_park}, exact {exact}"
+    );
     (p_rk, exact)
 }
 
@@ -76,7 +82,10 @@ fn pendulum_small_amplitude_period_is_2pi_sqrt_l_over_g() {
     let get = |n: &str| p[model.parameter_index(n).unwrap()];
     let leq = (0.4 * get("r").powi(2) + get("l").powi(2)) / get("l");
     let small = 2.0 * std::f64::consts::PI * (leq / get("g")).sqrt();
-    assert!(((measured - small) / small).abs() < 1e-6, "measured {measured}, 2π√(l/g) = {small}");
+    assert!(
+        ((measured - small) / small).abs() < 1e-6,
+        "measured {measured}, 2π√(l/g) = {small}"
+    );
     assert!(((measured - exact) / exact).abs() < 1e-6);
 }
 
@@ -84,7 +93,10 @@ fn pendulum_small_amplitude_period_is_2pi_sqrt_l_over_g() {
 fn pendulum_large_amplitude_period_matches_elliptic_integral() {
     for phi0 in [1.0, 2.5] {
         let (measured, exact) = pendulum_period(phi0);
-        assert!(((measured - exact) / exact).abs() < 1e-6, "θ0 = {phi0}: measured {measured}, exact {exact}");
+        assert!(
+            ((measured - exact) / exact).abs() < 1e-6,
+            "θ0 = {phi0}: measured {measured}, exact {exact}"
+        );
     }
 }
 
@@ -114,7 +126,10 @@ fn energy_drift_falls_at_rk4_order() {
         assert!(drift[1] < 1e-4, "{name}: RK4 energy drift {drift:?} J");
         // Energy error of RK4 falls at least at its order 4 (measured 4.1–4.7:
         // for these oscillatory runs the leading energy term is partly O(h⁵)).
-        assert!((3.5..5.2).contains(&order), "{name}: energy drift {drift:?} falls with order {order}");
+        assert!(
+            (3.5..5.2).contains(&order),
+            "{name}: energy drift {drift:?} falls with order {order}"
+        );
     }
 }
 
@@ -132,7 +147,10 @@ fn energy_drift_falls_at_park_order() {
             .collect();
         let order = (drift[0] / drift[1]).log2();
         // Park's method is dissipative (stiffly stable): energy decays at O(h²).
-        assert!((1.6..2.6).contains(&order), "{name}: Park energy drift {drift:?} falls with order {order}");
+        assert!(
+            (1.6..2.6).contains(&order),
+            "{name}: Park energy drift {drift:?} falls with order {order}"
+        );
     }
 }
 
@@ -175,33 +193,57 @@ fn park_and_rk4_convergence_orders_on_the_double_pendulum() {
         .iter()
         .map(|&h| {
             let (mut s, q0, v0) = numeric_system(&model, &[]);
-            err(on_grid(run_park(&mut s, &ParkSettings::fixed(h / 2.0), &q0, &v0, t_end).0))
+            err(on_grid(
+                run_park(&mut s, &ParkSettings::fixed(h / 2.0), &q0, &v0, t_end).0,
+            ))
         })
         .collect();
-    assert!((3.6..4.4).contains(&slope(&rk)), "RK4 errors {rk:?}, order {}", slope(&rk));
-    assert!((1.8..2.3).contains(&slope(&pk)), "Park errors {pk:?}, order {}", slope(&pk));
+    assert!(
+        (3.6..4.4).contains(&slope(&rk)),
+        "RK4 errors {rk:?}, order {}",
+        slope(&rk)
+    );
+    assert!(
+        (1.8..2.3).contains(&slope(&pk)),
+        "Park errors {pk:?}, order {}",
+        slope(&pk)
+    );
 }
 
 /// Angular momentum about the SC0 origin (kg m²/s) and kinetic energy (J) of the free body.
-fn momentum_and_energy(sys: &mut railmbs_runtime::ModelSystem, q: &[f64], v: &[f64], inertia: Matrix3<f64>, m: f64) -> (Vector3<f64>, f64, Matrix3<f64>) {
+fn momentum_and_energy(
+    sys: &mut railmbs_runtime::ModelSystem,
+    q: &[f64],
+    v: &[f64],
+    inertia: Matrix3<f64>,
+    m: f64,
+) -> (Vector3<f64>, f64, Matrix3<f64>) {
     let e = sys.evaluate(0.0, q, v, Parts::KINEMATICS).unwrap();
     let b = e.bodies[0];
     let ig = b.rotation * inertia * b.rotation.transpose();
     let l = m * b.position.cross(&b.velocity) + ig * b.angular_velocity;
-    let t = 0.5 * m * b.velocity.norm_squared() + 0.5 * b.angular_velocity.dot(&(ig * b.angular_velocity));
+    let t = 0.5 * m * b.velocity.norm_squared()
+        + 0.5 * b.angular_velocity.dot(&(ig * b.angular_velocity));
     (l, t, b.rotation)
 }
 
-fn free_body_run(wx: &str, wy: &str, wz: &str, rz0: &str) -> (Vec<(Vector3<f64>, f64, Matrix3<f64>)>, Matrix3<f64>) {
+/// Angular momentum, kinetic energy and orientation at every step.
+type RigidBodyRun = Vec<(Vector3<f64>, f64, Matrix3<f64>)>;
+
+fn free_body_run(wx: &str, wy: &str, wz: &str, rz0: &str) -> (RigidBodyRun, Matrix3<f64>) {
     let model = mechanism("free_body");
-    let (mut sys, q0, v0) = numeric_system(&model, &[("wx", wx), ("wy", wy), ("wz", wz), ("rz0", rz0)]);
+    let (mut sys, q0, v0) =
+        numeric_system(&model, &[("wx", wx), ("wy", wy), ("wz", wz), ("rz0", rz0)]);
     let p = sys.params().to_vec();
     let get = |n: &str| p[model.parameter_index(n).unwrap()];
     let inertia = Matrix3::from_diagonal(&Vector3::new(get("Ixx"), get("Iyy"), get("Izz")));
     let m = get("m");
     // RK4 at 0.5 ms conserves L and T to ~(ω h)⁴ ≈ 1e-10 relative over the run.
     let steps = run_rk4(&mut sys, &q0, &v0, 10.0, 5e-4);
-    let out = steps.iter().map(|(_, q, v)| momentum_and_energy(&mut sys, q, v, inertia, m)).collect();
+    let out = steps
+        .iter()
+        .map(|(_, q, v)| momentum_and_energy(&mut sys, q, v, inertia, m))
+        .collect();
     (out, inertia)
 }
 
@@ -213,19 +255,34 @@ fn torque_free_body_conserves_momentum_and_energy_and_flips_about_the_intermedia
     let (l0, t0, _) = run[0];
     let mut min_alignment: f64 = 1.0;
     for (l, t, a) in &run {
-        assert!((l - l0).norm() < 1e-6 * l0.norm(), "angular momentum drifted: {l} vs {l0}");
-        assert!((t - t0).abs() < 1e-6 * t0, "kinetic energy drifted: {t} vs {t0}");
+        assert!(
+            (l - l0).norm() < 1e-6 * l0.norm(),
+            "angular momentum drifted: {l} vs {l0}"
+        );
+        assert!(
+            (t - t0).abs() < 1e-6 * t0,
+            "kinetic energy drifted: {t} vs {t0}"
+        );
         min_alignment = min_alignment.min(a.column(1).dot(&l0.normalize()));
     }
-    assert!(min_alignment < -0.9, "the intermediate axis did not flip: min alignment {min_alignment}");
+    assert!(
+        min_alignment < -0.9,
+        "the intermediate axis did not flip: min alignment {min_alignment}"
+    );
     // Spin about the smallest (x) and largest (z) axes: stable. For x, the body
     // is first turned so that its x axis lies along global y (see the model file).
-    for (w, axis) in [(("1e-3", "5.0", "1e-3", "pi/2"), 0), (("1e-3", "1e-3", "5.0", "0"), 2)] {
+    for (w, axis) in [
+        (("1e-3", "5.0", "1e-3", "pi/2"), 0),
+        (("1e-3", "1e-3", "5.0", "0"), 2),
+    ] {
         let (run, _) = free_body_run(w.0, w.1, w.2, w.3);
         let l0 = run[0].0.normalize();
         for (l, _, a) in &run {
             assert!((l.normalize() - l0).norm() < 1e-6);
-            assert!(a.column(axis).dot(&l0) > 0.99, "spin about axis {axis} is not stable");
+            assert!(
+                a.column(axis).dot(&l0) > 0.99,
+                "spin about axis {axis} is not stable"
+            );
         }
     }
 }
@@ -242,18 +299,36 @@ fn spring_mass_damper_follows_the_exact_solution() {
     let wd = wn * (1.0 - zeta * zeta).sqrt();
     let ze = -l0 - m * g / k;
     let x0 = q0[0] - ze;
-    let exact = |t: f64| ze + (-zeta * wn * t).exp() * (x0 * (wd * t).cos() + zeta * wn * x0 / wd * (wd * t).sin());
+    let exact = |t: f64| {
+        ze + (-zeta * wn * t).exp() * (x0 * (wd * t).cos() + zeta * wn * x0 / wd * (wd * t).sin())
+    };
     // Park, second order, 0.1 ms: error ~ (ω h)² ≈ 1e-7 of the amplitude.
     let (steps, _) = run_park(&mut sys, &ParkSettings::fixed(1e-4), &q0, &v0, 5.0);
     let amplitude = x0.abs();
     for (t, q, _) in &steps {
-        assert!((q[0] - exact(*t)).abs() < 1e-6 * amplitude, "t = {t}: z = {}, exact {}", q[0], exact(*t));
+        assert!(
+            (q[0] - exact(*t)).abs() < 1e-6 * amplitude,
+            "t = {t}: z = {}, exact {}",
+            q[0],
+            exact(*t)
+        );
     }
     // Park with error control: the tolerance bounds the local error; the global
     // error over 5 s (≈ 8 periods) stays within 1e-4 of the amplitude.
-    let (steps, _) = run_park(&mut sys, &ParkSettings::with_tolerances(1e-8, 1e-8), &q0, &v0, 5.0);
+    let (steps, _) = run_park(
+        &mut sys,
+        &ParkSettings::with_tolerances(1e-8, 1e-8),
+        &q0,
+        &v0,
+        5.0,
+    );
     for (t, q, _) in &steps {
-        assert!((q[0] - exact(*t)).abs() < 1e-4 * amplitude, "adaptive Park, t = {t}: z = {}, exact {}", q[0], exact(*t));
+        assert!(
+            (q[0] - exact(*t)).abs() < 1e-4 * amplitude,
+            "adaptive Park, t = {t}: z = {}, exact {}",
+            q[0],
+            exact(*t)
+        );
     }
     let rk = run_rk4(&mut sys, &q0, &v0, 5.0, 1e-3);
     for (t, q, _) in &rk {
@@ -268,15 +343,29 @@ fn parallelogram_four_bar_moves_like_its_one_dof_equivalent() {
     assert_eq!(sys.n_constraints(), 2);
     let p = sys.params().to_vec();
     let get = |n: &str| p[model.parameter_index(n).unwrap()];
-    let (a, m1, m2, m3, g, th0) = (get("a"), get("m1"), get("m2"), get("m3"), get("g"), get("theta0"));
-    let settings = ParkSettings { max_step: 1e-3, ..ParkSettings::with_tolerances(1e-9, 1e-9) };
+    let (a, m1, m2, m3, g, th0) = (
+        get("a"),
+        get("m1"),
+        get("m2"),
+        get("m3"),
+        get("g"),
+        get("theta0"),
+    );
+    let settings = ParkSettings {
+        max_step: 1e-3,
+        ..ParkSettings::with_tolerances(1e-9, 1e-9)
+    };
     let (steps, _) = run_park(&mut sys, &settings, &q0, &v0, 5.0);
     // Constraint residual along the run.
     let mut gbuf = nalgebra::DVector::zeros(2);
     let mut jbuf = nalgebra::DMatrix::zeros(2, 3);
     for (t, q, _) in &steps {
         sys.constraints(*t, q, &mut gbuf, &mut jbuf).unwrap();
-        assert!(gbuf.abs().max() < 1e-9, "t = {t}: constraint residual {}", gbuf.abs().max());
+        assert!(
+            gbuf.abs().max() < 1e-9,
+            "t = {t}: constraint residual {}",
+            gbuf.abs().max()
+        );
         // The coupler keeps its orientation: absolute angle q1 + q2 = π/2.
         assert!((q[0] + q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-7);
     }
@@ -300,7 +389,11 @@ fn parallelogram_four_bar_moves_like_its_one_dof_equivalent() {
         let idx = (t / h).round() as usize;
         let (tr, thr) = ref_at[idx];
         if (tr - t).abs() < 1e-9 {
-            assert!((q[0] - thr).abs() < 1e-5, "t = {t}: crank {} vs equivalent pendulum {thr}", q[0]);
+            assert!(
+                (q[0] - thr).abs() < 1e-5,
+                "t = {t}: crank {} vs equivalent pendulum {thr}",
+                q[0]
+            );
         }
     }
 }

@@ -11,7 +11,11 @@ use railmbs_runtime::{Equations, Evaluation, Parts};
 const STATES: usize = 100;
 
 fn random_state(rng: &mut Rng, n: usize) -> (f64, Vec<f64>, Vec<f64>) {
-    (rng.uniform(0.0, 2.0), rng.vec(n, -1.5, 1.5), rng.vec(n, -2.0, 2.0))
+    (
+        rng.uniform(0.0, 2.0),
+        rng.vec(n, -1.5, 1.5),
+        rng.vec(n, -2.0, 2.0),
+    )
 }
 
 /// Direct method: M = Σ_j Γ_jᵀ diag(m_j E, A_j I_j A_jᵀ) Γ_j.
@@ -53,8 +57,17 @@ fn composite_body_mass_matrix_equals_direct_method_and_is_spd() {
             eng.evaluate(t, &q, &v, Parts::ALL, &mut e).unwrap();
             let direct = direct_mass(&model, &params, &e);
             let err = rel_err(&e.mass, &direct);
-            assert!(err < 1e-12, "{}: composite-body M differs from direct M by {err:e}", model.name);
-            assert_eq!(e.mass, e.mass.transpose(), "{}: M not symmetric", model.name);
+            assert!(
+                err < 1e-12,
+                "{}: composite-body M differs from direct M by {err:e}",
+                model.name
+            );
+            assert_eq!(
+                e.mass,
+                e.mass.transpose(),
+                "{}: M not symmetric",
+                model.name
+            );
             assert!(
                 e.mass.clone().cholesky().is_some(),
                 "{}: M not positive definite at q = {q:?}",
@@ -82,8 +95,10 @@ fn body_jacobians_match_finite_differences_of_positions_and_orientations() {
                 qp[i] += h;
                 let mut qm = q.clone();
                 qm[i] -= h;
-                eng.evaluate(t, &qp, &v, Parts::KINEMATICS, &mut ep).unwrap();
-                eng.evaluate(t, &qm, &v, Parts::KINEMATICS, &mut em).unwrap();
+                eng.evaluate(t, &qp, &v, Parts::KINEMATICS, &mut ep)
+                    .unwrap();
+                eng.evaluate(t, &qm, &v, Parts::KINEMATICS, &mut em)
+                    .unwrap();
                 for j in 0..eng.body_count() {
                     let dr = (ep.bodies[j].position - em.bodies[j].position) / (2.0 * h);
                     // ∂A/∂q_i · Aᵀ = skew(angular column)
@@ -93,8 +108,16 @@ fn body_jacobians_match_finite_differences_of_positions_and_orientations() {
                     for k in 0..3 {
                         // Central differences: truncation O(h²) ≈ 1e-12, rounding ≈ 1e-16/h ≈ 1e-10.
                         let tol = 1e-7;
-                        assert!((e.jacobians[(6 * j + k, i)] - dr[k]).abs() < tol, "{}: Γ lin", model.name);
-                        assert!((e.jacobians[(6 * j + 3 + k, i)] - dw[k]).abs() < tol, "{}: Γ ang", model.name);
+                        assert!(
+                            (e.jacobians[(6 * j + k, i)] - dr[k]).abs() < tol,
+                            "{}: Γ lin",
+                            model.name
+                        );
+                        assert!(
+                            (e.jacobians[(6 * j + 3 + k, i)] - dw[k]).abs() < tol,
+                            "{}: Γ ang",
+                            model.name
+                        );
                     }
                 }
             }
@@ -121,29 +144,40 @@ fn bias_forces_equal_projected_inertia_forces_at_zero_acceleration() {
             let h = 1e-5;
             let qp: Vec<f64> = q.iter().zip(&v).map(|(a, b)| a + h * b).collect();
             let qm: Vec<f64> = q.iter().zip(&v).map(|(a, b)| a - h * b).collect();
-            eng.evaluate(t + h, &qp, &v, Parts::KINEMATICS, &mut ep).unwrap();
-            eng.evaluate(t - h, &qm, &v, Parts::KINEMATICS, &mut em).unwrap();
+            eng.evaluate(t + h, &qp, &v, Parts::KINEMATICS, &mut ep)
+                .unwrap();
+            eng.evaluate(t - h, &qm, &v, Parts::KINEMATICS, &mut em)
+                .unwrap();
             let mut k: DVector<f64> = DVector::zeros(n);
             for (j, b) in model.bodies.iter().enumerate() {
                 let m = b.mass.eval(&params, 0.0);
                 let iv: Vec<f64> = b.inertia.iter().map(|x| x.eval(&params, 0.0)).collect();
-                let ib = Matrix3::new(iv[0], iv[3], iv[4], iv[3], iv[1], iv[5], iv[4], iv[5], iv[2]);
+                let ib = Matrix3::new(
+                    iv[0], iv[3], iv[4], iv[3], iv[1], iv[5], iv[4], iv[5], iv[2],
+                );
                 let a = e.bodies[j].rotation;
                 let ig = a * ib * a.transpose();
                 let acc = (ep.bodies[j].velocity - em.bodies[j].velocity) / (2.0 * h);
-                let alpha = (ep.bodies[j].angular_velocity - em.bodies[j].angular_velocity) / (2.0 * h);
+                let alpha =
+                    (ep.bodies[j].angular_velocity - em.bodies[j].angular_velocity) / (2.0 * h);
                 let w = e.bodies[j].angular_velocity;
                 let f = m * acc;
                 let mo = ig * alpha + w.cross(&(ig * w));
                 let g = e.jacobians.rows(6 * j, 6);
                 for i in 0..n {
-                    k[i] += (0..3).map(|r| g[(r, i)] * f[r] + g[(3 + r, i)] * mo[r]).sum::<f64>();
+                    k[i] += (0..3)
+                        .map(|r| g[(r, i)] * f[r] + g[(3 + r, i)] * mo[r])
+                        .sum::<f64>();
                 }
             }
             let scale = k.abs().max().max(1.0);
             let err = (&e.bias - &k).abs().max() / scale;
             // Central differences with h = 1e-5: truncation ~h² = 1e-10 relative.
-            assert!(err < 1e-6, "{}: bias k differs from FD inertia forces by {err:e}", model.name);
+            assert!(
+                err < 1e-6,
+                "{}: bias k differs from FD inertia forces by {err:e}",
+                model.name
+            );
         }
     }
 }
@@ -154,17 +188,24 @@ fn gravity_forces_are_minus_gradient_of_potential() {
         let mut eng = numeric_engine(&model);
         let params = model.default_parameter_values();
         let g: Vec<f64> = model.gravity.iter().map(|x| x.eval(&params, 0.0)).collect();
-        let masses: Vec<f64> = model.bodies.iter().map(|b| b.mass.eval(&params, 0.0)).collect();
+        let masses: Vec<f64> = model
+            .bodies
+            .iter()
+            .map(|b| b.mass.eval(&params, 0.0))
+            .collect();
         let n = eng.dof();
         let mut e = Evaluation::for_equations(&eng);
         let mut rng = Rng::new(3);
         let potential = |eng: &mut railmbs_runtime::NumericEquations, t: f64, q: &[f64]| {
             let mut ev = Evaluation::for_equations(eng);
-            eng.evaluate(t, q, &vec![0.0; q.len()], Parts::KINEMATICS, &mut ev).unwrap();
+            eng.evaluate(t, q, &vec![0.0; q.len()], Parts::KINEMATICS, &mut ev)
+                .unwrap();
             ev.bodies
                 .iter()
                 .zip(&masses)
-                .map(|(b, m)| -m * (g[0] * b.position.x + g[1] * b.position.y + g[2] * b.position.z))
+                .map(|(b, m)| {
+                    -m * (g[0] * b.position.x + g[1] * b.position.y + g[2] * b.position.z)
+                })
                 .sum::<f64>()
         };
         for _ in 0..20 {
@@ -178,7 +219,13 @@ fn gravity_forces_are_minus_gradient_of_potential() {
                 qm[i] -= h;
                 let dv = (potential(&mut eng, t, &qp) - potential(&mut eng, t, &qm)) / (2.0 * h);
                 let tol = 1e-6 * (1.0 + dv.abs());
-                assert!((e.gravity[i] + dv).abs() < tol, "{}: Q_g[{i}] = {} vs −∂V/∂q = {}", model.name, e.gravity[i], -dv);
+                assert!(
+                    (e.gravity[i] + dv).abs() < tol,
+                    "{}: Q_g[{i}] = {} vs −∂V/∂q = {}",
+                    model.name,
+                    e.gravity[i],
+                    -dv
+                );
             }
         }
     }
@@ -204,7 +251,12 @@ fn rheonomic_pivot_gives_the_closed_form_equation() {
         let k_exact = m * l * xs_dd * phi.cos();
         let qg_exact = -m * g * l * phi.sin();
         assert!((e.mass[(0, 0)] - m_exact).abs() < 1e-12 * m_exact);
-        assert!((e.bias[0] - k_exact).abs() < 1e-12 * (1.0 + k_exact.abs()), "k = {} vs {}", e.bias[0], k_exact);
+        assert!(
+            (e.bias[0] - k_exact).abs() < 1e-12 * (1.0 + k_exact.abs()),
+            "k = {} vs {}",
+            e.bias[0],
+            k_exact
+        );
         assert!((e.gravity[0] - qg_exact).abs() < 1e-12 * (1.0 + qg_exact.abs()));
     }
 }

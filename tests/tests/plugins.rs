@@ -14,9 +14,13 @@ fn cache() -> PathBuf {
 }
 
 fn build(model: &railmbs_models::Model, abi: u32) -> PathBuf {
-    railmbs_codegen::build_plugin(model, &railmbs_codegen::GenerateOptions::new(abi), Some(cache()))
-        .unwrap_or_else(|e| panic!("{e}"))
-        .path
+    railmbs_codegen::build_plugin(
+        model,
+        &railmbs_codegen::GenerateOptions::new(abi),
+        Some(cache()),
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .path
 }
 
 #[test]
@@ -32,7 +36,10 @@ fn plugin_of_another_model_is_refused() {
     let err = Plugin::load_for(&path, &changed).unwrap_err();
     assert!(matches!(err, PluginError::ModelMismatch { .. }), "{err}");
     let msg = err.to_string();
-    assert!(msg.contains("another model") && msg.contains("umgen"), "{msg}");
+    assert!(
+        msg.contains("another model") && msg.contains("umgen"),
+        "{msg}"
+    );
     // A different default value is not a structural change: accepted.
     let mut other_default = pendulum.clone();
     other_default.parameters[0].default = railmbs_models::Expr::Num(2.0);
@@ -87,7 +94,10 @@ fn fixed_parameters_are_folded_and_other_values_refused() {
     assert!(err.contains("\"l\"") && err.contains("fixed"), "{err}");
     let err = railmbs_codegen::build_plugin(
         &model,
-        &railmbs_codegen::GenerateOptions { fixed: vec!["nope".into()], ..opts },
+        &railmbs_codegen::GenerateOptions {
+            fixed: vec!["nope".into()],
+            ..opts
+        },
         Some(cache()),
     )
     .unwrap_err()
@@ -97,12 +107,24 @@ fn fixed_parameters_are_folded_and_other_values_refused() {
 
 #[test]
 fn symbolic_and_numeric_engines_give_the_same_trajectories() {
-    for name in ["double_pendulum", "fourbar", "spring_mass", "shaken_pendulum", "chain10"] {
+    for name in [
+        "double_pendulum",
+        "fourbar",
+        "spring_mass",
+        "shaken_pendulum",
+        "chain10",
+    ] {
         let model = mechanism(name);
         let params = model.default_parameter_values();
         let (q0, v0) = model.initial_state(&params);
-        let mut num = ModelSystem::new(&model, Box::new(NumericEquations::new(&model)), params.clone()).unwrap();
-        let mut sym = ModelSystem::new(&model, Box::new(symbolic_engine(&model)), params.clone()).unwrap();
+        let mut num = ModelSystem::new(
+            &model,
+            Box::new(NumericEquations::new(&model)),
+            params.clone(),
+        )
+        .unwrap();
+        let mut sym =
+            ModelSystem::new(&model, Box::new(symbolic_engine(&model)), params.clone()).unwrap();
         // Fixed step: the engines differ only by rounding, so the states agree
         // to far below any integration error.
         let fixed = ParkSettings::fixed(1e-3);
@@ -111,7 +133,10 @@ fn symbolic_and_numeric_engines_give_the_same_trajectories() {
         for ((ta, qa, _), (tb, qb, _)) in a.iter().zip(&b) {
             assert_eq!(ta, tb);
             for (x, y) in qa.iter().zip(qb) {
-                assert!((x - y).abs() < 1e-9 * (1.0 + x.abs()), "{name}, t = {ta}: {x} vs {y}");
+                assert!(
+                    (x - y).abs() < 1e-9 * (1.0 + x.abs()),
+                    "{name}, t = {ta}: {x} vs {y}"
+                );
             }
         }
         // Error control may pick a different step now and then (a rounding-level

@@ -16,7 +16,10 @@ fn close(a: &DMatrix<f64>, b: &DMatrix<f64>, what: &str, model: &str) {
 /// exactly zero symbolically is ~1e-17 numerically).
 fn close_scaled(a: &DMatrix<f64>, b: &DMatrix<f64>, scale: f64, what: &str, model: &str) {
     let err = (a - b).abs().max() / scale;
-    assert!(err < 1e-12, "{model}: {what} differs by {err:e} relative (symbolic vs numeric)");
+    assert!(
+        err < 1e-12,
+        "{model}: {what} differs by {err:e} relative (symbolic vs numeric)"
+    );
 }
 
 #[test]
@@ -35,21 +38,57 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
             num.evaluate(t, &q, &v, Parts::ALL, &mut en).unwrap();
             sym.evaluate(t, &q, &v, Parts::ALL, &mut es).unwrap();
             close(&es.mass, &en.mass, "M", &model.name);
-            let col = |x: &nalgebra::DVector<f64>| DMatrix::from_column_slice(x.len(), 1, x.as_slice());
+            let col =
+                |x: &nalgebra::DVector<f64>| DMatrix::from_column_slice(x.len(), 1, x.as_slice());
             // Natural scales: inertia forces |M|(1 + |q̇|²), gravity |M|·|g|.
             let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let k_scale = en.mass.abs().max() * (1.0 + vmax * vmax);
-            close_scaled(&col(&es.bias), &col(&en.bias), k_scale.max(en.bias.abs().max()), "k", &model.name);
+            close_scaled(
+                &col(&es.bias),
+                &col(&en.bias),
+                k_scale.max(en.bias.abs().max()),
+                "k",
+                &model.name,
+            );
             let g_scale = en.mass.abs().max() * 9.81;
-            close_scaled(&col(&es.gravity), &col(&en.gravity), g_scale.max(en.gravity.abs().max()), "Q_g", &model.name);
+            close_scaled(
+                &col(&es.gravity),
+                &col(&en.gravity),
+                g_scale.max(en.gravity.abs().max()),
+                "Q_g",
+                &model.name,
+            );
             close(&es.jacobians, &en.jacobians, "Γ", &model.name);
             for (a, b) in es.bodies.iter().zip(&en.bodies) {
-                let pa = DMatrix::from_iterator(18, 1, a.position.iter().chain(a.rotation.iter()).chain(a.velocity.iter()).chain(a.angular_velocity.iter()).copied());
-                let pb = DMatrix::from_iterator(18, 1, b.position.iter().chain(b.rotation.iter()).chain(b.velocity.iter()).chain(b.angular_velocity.iter()).copied());
+                let pa = DMatrix::from_iterator(
+                    18,
+                    1,
+                    a.position
+                        .iter()
+                        .chain(a.rotation.iter())
+                        .chain(a.velocity.iter())
+                        .chain(a.angular_velocity.iter())
+                        .copied(),
+                );
+                let pb = DMatrix::from_iterator(
+                    18,
+                    1,
+                    b.position
+                        .iter()
+                        .chain(b.rotation.iter())
+                        .chain(b.velocity.iter())
+                        .chain(b.angular_velocity.iter())
+                        .copied(),
+                );
                 close(&pa, &pb, "body kinematics", &model.name);
             }
             if num.constraint_count() > 0 {
-                close(&es.constraint_jacobian, &en.constraint_jacobian, "G", &model.name);
+                close(
+                    &es.constraint_jacobian,
+                    &en.constraint_jacobian,
+                    "G",
+                    &model.name,
+                );
                 let ga = col(&es.constraints);
                 let gb = col(&en.constraints);
                 close(&ga, &gb, "g", &model.name);

@@ -4,7 +4,11 @@ use clap::{Parser, Subcommand};
 use railmbs_cli::{bench, conicity, creep, run};
 
 #[derive(Parser)]
-#[command(name = "umsim", version, about = "railmbs simulator: run scenarios, benchmark engines, wheel-rail tools")]
+#[command(
+    name = "umsim",
+    version,
+    about = "railmbs simulator: run scenarios, benchmark engines, wheel-rail tools"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

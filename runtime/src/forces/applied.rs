@@ -1,6 +1,9 @@
 //! Applied force and torque (constant or a function of time).
 
-use super::{add_force, add_moment, eval_vector, Attachment, ForceContext, ForceElement, Wrench};
+use super::{
+    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment,
+    eval_vector,
+};
 use crate::system::SimError;
 use nalgebra::Vector3;
 use railmbs_models::{BodyRef, Expr, ForceKind, VectorFrame};
@@ -69,11 +72,23 @@ impl ForceElement for AppliedForce {
     }
 
     fn output_names(&self) -> Vec<String> {
-        ["Fx[N]", "Fy[N]", "Fz[N]"].iter().map(|s| s.to_string()).collect()
+        ["Fx[N]", "Fy[N]", "Fz[N]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// A prescribed force does not depend on q or q̇ (a body-frame force turns
+    /// with the body; that term involves ∂Γ/∂q and is neglected as in Sect. 6).
+    fn add_jacobian(&self, _ctx: &ForceContext, _jac: &mut ForceJacobian) -> Result<(), SimError> {
+        Ok(())
     }
 
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
-        let f = self.vectors(ctx).map(|(f, _)| f).unwrap_or(Vector3::repeat(f64::NAN));
+        let f = self
+            .vectors(ctx)
+            .map(|(f, _)| f)
+            .unwrap_or(Vector3::repeat(f64::NAN));
         out.extend(f.iter());
     }
 }

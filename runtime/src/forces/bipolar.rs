@@ -1,7 +1,10 @@
 //! Linear bipolar viscoelastic element (seed paper Sect. 3.1).
 
-use super::{add_force, eval_scalar, Attachment, ForceContext, ForceElement, Wrench};
+use super::{
+    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
+};
 use crate::system::SimError;
+use nalgebra::{Matrix3, Vector3};
 use railmbs_models::{Expr, ForceKind};
 
 /// Spring–damper between two points: F = c (x − x0) + d ẋ + f0 along the line of
@@ -48,8 +51,16 @@ impl LinearBipolar {
         };
         Self {
             name,
-            ends: [Attachment::new(*body1, point1), Attachment::new(*body2, point2)],
-            exprs: [stiffness.clone(), damping.clone(), preload.clone(), free_length.clone()],
+            ends: [
+                Attachment::new(*body1, point1),
+                Attachment::new(*body2, point2),
+            ],
+            exprs: [
+                stiffness.clone(),
+                damping.clone(),
+                preload.clone(),
+                free_length.clone(),
+            ],
             stiffness: 0.0,
             damping: 0.0,
             preload: 0.0,
@@ -78,6 +89,31 @@ impl LinearBipolar {
 
     fn force(&self, x: &Deflection) -> f64 {
         self.stiffness * (x.length - self.free_length) + self.damping * x.rate + self.preload
+    }
+
+    /// Local Jacobians of the force on end 2, f₂ = −F e, with respect to
+    /// d = P₂ − P₁ and ḋ (F the tension, x = |d|, e = d/x, ẋ = e·ḋ):
+    /// ∂f₂/∂d = −[e (c e + d (E − e eᵀ) ḋ / x)ᵀ + (F/x)(E − e eᵀ)], ∂f₂/∂ḋ = −d e eᵀ.
+    /// Zero at zero length (no direction, no force).
+    pub(crate) fn local_jacobian(
+        d: &Vector3<f64>,
+        dd: &Vector3<f64>,
+        force_rate: (f64, f64),
+        force: impl Fn(f64, f64) -> f64,
+    ) -> (Matrix3<f64>, Matrix3<f64>) {
+        let x = d.norm();
+        if x <= f64::MIN_POSITIVE {
+            return (Matrix3::zeros(), Matrix3::zeros());
+        }
+        let e = d / x;
+        let rate = e.dot(dd);
+        let (c, dmp) = force_rate;
+        let f = force(x, rate);
+        let transverse = Matrix3::identity() - e * e.transpose();
+        let g = c * e + dmp * (transverse * dd) / x;
+        let kq = -(e * g.transpose() + (f / x) * transverse);
+        let kv = -dmp * e * e.transpose();
+        (kq, kv)
     }
 }
 
@@ -117,7 +153,23 @@ impl ForceElement for LinearBipolar {
 
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let x = self.deflection(ctx);
-        let f = if x.direction.is_some() { self.force(&x) } else { 0.0 };
+        let f = if x.direction.is_some() {
+            self.force(&x)
+        } else {
+            0.0
+        };
         out.extend([f, x.length, x.rate]);
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let p1 = self.ends[0].position(ctx);
+        let p2 = self.ends[1].position(ctx);
+        let dd = self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx);
+        let (kq, kv) =
+            Self::local_jacobian(&(p2 - p1), &dd, (self.stiffness, self.damping), |x, v| {
+                self.stiffness * (x - self.free_length) + self.damping * v + self.preload
+            });
+        jac.add_point_pair(self.ends[0].body, &p1, self.ends[1].body, &p2, &kq, &kv);
+        Ok(())
     }
 }

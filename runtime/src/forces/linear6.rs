@@ -1,6 +1,9 @@
 //! Generalized linear 6×6 elastic and dissipative element (seed paper Sect. 3.2).
 
-use super::{add_force, add_moment, eval_scalar, FrameAttachment, ForceContext, ForceElement, Wrench};
+use super::{
+    ForceContext, ForceElement, ForceJacobian, FrameAttachment, Wrench, add_force, add_moment,
+    eval_scalar,
+};
 use crate::system::SimError;
 use nalgebra::{Matrix6, Vector3, Vector6};
 use railmbs_models::{Expr, ForceKind};
@@ -68,13 +71,16 @@ impl Linear6 {
             0.5 * (r[(0, 2)] - r[(2, 0)]),
             0.5 * (r[(1, 0)] - r[(0, 1)]),
         );
-        let dv = self.frames[1].point.velocity(ctx) - self.frames[0].point.velocity(ctx) - w1.cross(&d);
+        let dv =
+            self.frames[1].point.velocity(ctx) - self.frames[0].point.velocity(ctx) - w1.cross(&d);
         let lin = a1.transpose() * d;
         let lin_rate = a1.transpose() * dv;
         let ang_rate = a1.transpose() * (w2 - w1);
         (
             Vector6::new(lin.x, lin.y, lin.z, theta.x, theta.y, theta.z),
-            Vector6::new(lin_rate.x, lin_rate.y, lin_rate.z, ang_rate.x, ang_rate.y, ang_rate.z),
+            Vector6::new(
+                lin_rate.x, lin_rate.y, lin_rate.z, ang_rate.x, ang_rate.y, ang_rate.z,
+            ),
         )
     }
 
@@ -128,5 +134,21 @@ impl ForceElement for Linear6 {
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         // The wrench body 1 exerts on body 2, in frame 1.
         out.extend(self.wrench_in_frame1(ctx).iter());
+    }
+
+    /// W = −(C δ + D δ̇ + W₀): ∂W/∂δ = −C, ∂W/∂δ̇ = −D, mapped by the relative
+    /// motion Jacobian of the frames (exact at zero deflection and rate).
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let p2 = self.frames[1].point.position(ctx);
+        let (a1, _) = self.frames[0].orientation(ctx);
+        jac.add_frame_pair(
+            self.frames[0].point.body,
+            self.frames[1].point.body,
+            &p2,
+            &a1,
+            &(-self.stiffness),
+            &(-self.damping),
+        );
+        Ok(())
     }
 }

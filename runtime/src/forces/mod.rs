@@ -15,7 +15,7 @@ pub use linear6::Linear6;
 
 use crate::equations::BodyKinematics;
 use crate::system::SimError;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3};
 use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model};
 
 /// Force (N) and moment about the centre of mass (N m) on one body, in SC0.
@@ -50,6 +50,212 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>);
     /// Called once per accepted step (elements with state update here only).
     fn accept_step(&mut self, _ctx: &ForceContext) {}
+    /// Adds the element's approximate contribution to ∂Q/∂q and ∂Q/∂q̇ (paper
+    /// Sect. 6, Eq. 31): its local stiffness and damping matrices mapped by the
+    /// Jacobians of its attachment points, neglecting the derivatives of the
+    /// body Jacobians Γ themselves. Uses the element's current state (mode,
+    /// anchors) like [`ForceElement::apply`].
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError>;
+}
+
+/// Scratch buffers of [`ForceJacobian`] (kept by the system between calls).
+#[derive(Debug, Clone, Default)]
+pub struct JacobianScratch {
+    /// Up to 6 rows of a relative-motion Jacobian H (6 × n).
+    h: DMatrix<f64>,
+    /// Columns where H has non-zero entries.
+    cols: Vec<usize>,
+    /// K·H restricted to those columns (6 × cols).
+    kh: Vec<f64>,
+}
+
+impl JacobianScratch {
+    /// Buffers for `n` generalized coordinates.
+    pub fn new(n: usize) -> Self {
+        Self {
+            h: DMatrix::zeros(6, n),
+            cols: Vec::with_capacity(n),
+            kh: vec![0.0; 6 * n],
+        }
+    }
+}
+
+/// Accumulates the approximate Jacobians of the generalized applied forces,
+/// `dq` ≈ ∂Q/∂q and `dv` ≈ ∂Q/∂q̇, from the elements' local Jacobians.
+///
+/// An element whose force on body 2, f₂, depends on the relative position
+/// d = P₂ − P₁ and velocity ḋ of its attachment points (body 1 gets −f₂)
+/// contributes Q = Gᵀ f₂ with G = Γ_P₂ − Γ_P₁, where Γ_P = Γ_t + (Γ_r × ρ)
+/// column by column (ρ from the centre of mass to the point, SC0) is the point
+/// Jacobian. Hence ∂Q/∂q ≈ Gᵀ (∂f₂/∂d) G and ∂Q/∂q̇ ≈ Gᵀ (∂f₂/∂ḋ) G, the terms
+/// with ∂Γ/∂q (proportional to the force itself) being neglected as in the
+/// seed paper, Sect. 6.
+pub struct ForceJacobian<'a> {
+    gamma: &'a DMatrix<f64>,
+    bodies: &'a [crate::equations::BodyKinematics],
+    /// ≈ ∂Q/∂q, n × n (N/m, N m/rad…).
+    pub dq: &'a mut DMatrix<f64>,
+    /// ≈ ∂Q/∂q̇, n × n.
+    pub dv: &'a mut DMatrix<f64>,
+    scratch: &'a mut JacobianScratch,
+}
+
+impl<'a> ForceJacobian<'a> {
+    /// `gamma`: the stacked body Jacobians Γ_j (rows 6j..6j+3 the velocity of
+    /// the centre of mass, 6j+3..6j+6 the angular velocity, SC0); `bodies` the
+    /// kinematics at the same state. `dq`, `dv` are added to, not cleared.
+    pub fn new(
+        gamma: &'a DMatrix<f64>,
+        bodies: &'a [crate::equations::BodyKinematics],
+        dq: &'a mut DMatrix<f64>,
+        dv: &'a mut DMatrix<f64>,
+        scratch: &'a mut JacobianScratch,
+    ) -> Self {
+        let n = dq.ncols();
+        if scratch.h.ncols() != n {
+            *scratch = JacobianScratch::new(n);
+        }
+        Self {
+            gamma,
+            bodies,
+            dq,
+            dv,
+            scratch,
+        }
+    }
+
+    /// Adds `sign`·Γ_P of the point `p` (SC0) of `body` to rows row0..row0+3 of H.
+    fn point_rows(&mut self, row0: usize, body: Option<usize>, p: &Vector3<f64>, sign: f64) {
+        let Some(b) = body else { return };
+        let rho = p - self.bodies[b].position;
+        let g = self.gamma;
+        for i in 0..g.ncols() {
+            let w = Vector3::new(g[(6 * b + 3, i)], g[(6 * b + 4, i)], g[(6 * b + 5, i)]);
+            let v = Vector3::new(g[(6 * b, i)], g[(6 * b + 1, i)], g[(6 * b + 2, i)]);
+            let c = v + w.cross(&rho);
+            for k in 0..3 {
+                self.scratch.h[(row0 + k, i)] += sign * c[k];
+            }
+        }
+    }
+
+    /// Adds `sign`·Γ_r of `body` to rows row0..row0+3 of H.
+    fn rotation_rows(&mut self, row0: usize, body: Option<usize>, sign: f64) {
+        let Some(b) = body else { return };
+        for i in 0..self.gamma.ncols() {
+            for k in 0..3 {
+                self.scratch.h[(row0 + k, i)] += sign * self.gamma[(6 * b + 3 + k, i)];
+            }
+        }
+    }
+
+    /// Adds Hᵀ kq H to `dq` and Hᵀ kv H to `dv` for the first `rows` rows of H
+    /// (kq, kv given as closures over (row, col) of the rows × rows matrices),
+    /// then clears H.
+    fn project(
+        &mut self,
+        rows: usize,
+        kq: impl Fn(usize, usize) -> f64,
+        kv: impl Fn(usize, usize) -> f64,
+    ) {
+        let s = &mut *self.scratch;
+        s.cols.clear();
+        for i in 0..s.h.ncols() {
+            if (0..rows).any(|r| s.h[(r, i)] != 0.0) {
+                s.cols.push(i);
+            }
+        }
+        let nc = s.cols.len();
+        for (pass, out) in [(0, &mut *self.dq), (1, &mut *self.dv)] {
+            let k = |r: usize, c: usize| if pass == 0 { kq(r, c) } else { kv(r, c) };
+            // KH (rows × nc).
+            let mut any = false;
+            for r in 0..rows {
+                for (ci, &col) in s.cols.iter().enumerate() {
+                    let mut acc = 0.0;
+                    for m in 0..rows {
+                        acc += k(r, m) * s.h[(m, col)];
+                    }
+                    s.kh[r * nc + ci] = acc;
+                    any |= acc != 0.0;
+                }
+            }
+            if !any {
+                continue;
+            }
+            for &a in &s.cols {
+                for (ci, &b) in s.cols.iter().enumerate() {
+                    let mut acc = 0.0;
+                    for r in 0..rows {
+                        acc += s.h[(r, a)] * s.kh[r * nc + ci];
+                    }
+                    out[(a, b)] += acc;
+                }
+            }
+        }
+        for r in 0..rows {
+            s.h.row_mut(r).fill(0.0);
+        }
+    }
+
+    /// A force f₂ on `body2` at `p2` and −f₂ on `body1` at `p1` (points in
+    /// SC0) depending on d = P₂ − P₁ and ḋ: adds Gᵀ kq G and Gᵀ kv G with
+    /// kq = ∂f₂/∂d (N/m) and kv = ∂f₂/∂ḋ (N s/m).
+    pub fn add_point_pair(
+        &mut self,
+        body1: Option<usize>,
+        p1: &Vector3<f64>,
+        body2: Option<usize>,
+        p2: &Vector3<f64>,
+        kq: &Matrix3<f64>,
+        kv: &Matrix3<f64>,
+    ) {
+        if body1.is_none() && body2.is_none() {
+            return;
+        }
+        self.point_rows(0, body2, p2, 1.0);
+        self.point_rows(0, body1, p1, -1.0);
+        self.project(3, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
+    }
+
+    /// A wrench w = (force, moment) expressed in a frame with direction cosines
+    /// `a1` (SC0), acting on `body2` at the point `p` (SC0), and −w on `body1`
+    /// at the same point, depending on the relative displacement δ and rate δ̇
+    /// of body 2 with respect to body 1 (translation of the point and small
+    /// rotation, in the same frame): adds Hᵀ kq H and Hᵀ kv H with
+    /// H = diag(a1ᵀ, a1ᵀ)·[Γ_P⁽²⁾ − Γ_P⁽¹⁾; Γ_r⁽²⁾ − Γ_r⁽¹⁾], kq = ∂w/∂δ, kv = ∂w/∂δ̇.
+    pub fn add_frame_pair(
+        &mut self,
+        body1: Option<usize>,
+        body2: Option<usize>,
+        p: &Vector3<f64>,
+        a1: &Matrix3<f64>,
+        kq: &Matrix6<f64>,
+        kv: &Matrix6<f64>,
+    ) {
+        if body1.is_none() && body2.is_none() {
+            return;
+        }
+        self.point_rows(0, body2, p, 1.0);
+        self.point_rows(0, body1, p, -1.0);
+        self.rotation_rows(3, body2, 1.0);
+        self.rotation_rows(3, body1, -1.0);
+        // Rotate the rows into the frame: H ← diag(a1ᵀ, a1ᵀ) H.
+        let at = a1.transpose();
+        let h = &mut self.scratch.h;
+        for i in 0..h.ncols() {
+            for blk in [0, 3] {
+                let x = Vector3::new(h[(blk, i)], h[(blk + 1, i)], h[(blk + 2, i)]);
+                if x != Vector3::zeros() {
+                    let y = at * x;
+                    for k in 0..3 {
+                        h[(blk + k, i)] = y[k];
+                    }
+                }
+            }
+        }
+        self.project(6, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
+    }
 }
 
 /// Builds the runtime force elements of a model.
@@ -150,7 +356,11 @@ pub(crate) fn eval_vector(
     t: f64,
     owner: &str,
 ) -> Result<Vector3<f64>, SimError> {
-    let v = Vector3::new(e[0].eval(params, t), e[1].eval(params, t), e[2].eval(params, t));
+    let v = Vector3::new(
+        e[0].eval(params, t),
+        e[1].eval(params, t),
+        e[2].eval(params, t),
+    );
     if v.iter().all(|x| x.is_finite()) {
         Ok(v)
     } else {
@@ -162,7 +372,12 @@ pub(crate) fn eval_vector(
 }
 
 /// Evaluates one parameter expression, refusing non-finite results.
-pub(crate) fn eval_scalar(e: &Expr, params: &[f64], owner: &str, field: &str) -> Result<f64, SimError> {
+pub(crate) fn eval_scalar(
+    e: &Expr,
+    params: &[f64],
+    owner: &str,
+    field: &str,
+) -> Result<f64, SimError> {
     let v = e.eval(params, 0.0);
     if v.is_finite() {
         Ok(v)

@@ -3,14 +3,16 @@
 
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
-use railmbs_runtime::integrate::{integrate_park, integrate_rk4, ParkSettings, Rk4Settings};
+use railmbs_runtime::integrate::{ParkSettings, Rk4Settings, integrate_park, integrate_rk4};
 use railmbs_runtime::{Equations, MechanicalSystem, ModelSystem, NumericEquations, Parts};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 /// Path of a file under the repository's `models/` folder.
 pub fn model_path(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models").join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../models")
+        .join(rel)
 }
 
 /// Loads `models/mechanisms/<name>.ron`.
@@ -33,12 +35,17 @@ pub fn all_mechanisms() -> Vec<Model> {
 }
 
 /// A system with the numeric engine and the given parameter overrides.
-pub fn numeric_system(model: &Model, overrides: &[(&str, &str)]) -> (ModelSystem, Vec<f64>, Vec<f64>) {
+pub fn numeric_system(
+    model: &Model,
+    overrides: &[(&str, &str)],
+) -> (ModelSystem, Vec<f64>, Vec<f64>) {
     let ov: Vec<(String, String)> = overrides
         .iter()
         .map(|(a, b)| (a.to_string(), b.to_string()))
         .collect();
-    let params = model.parameter_values(&[], &ov).unwrap_or_else(|e| panic!("{e}"));
+    let params = model
+        .parameter_values(&[], &ov)
+        .unwrap_or_else(|e| panic!("{e}"));
     let (q0, v0) = model.initial_state(&params);
     let sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
     (sys, q0, v0)
@@ -65,10 +72,20 @@ impl Rng {
 /// Kinetic energy ½ q̇ᵀ M q̇ plus potential energy −Σ m_j g·r_j (J), at a state
 /// of a model whose only forces are gravity (and conservative springs, which
 /// are not included here).
-pub fn mechanical_energy(model: &Model, sys: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> f64 {
+pub fn mechanical_energy(
+    model: &Model,
+    sys: &mut ModelSystem,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+) -> f64 {
     let params = sys.params().to_vec();
     let g: Vec<f64> = model.gravity.iter().map(|e| e.eval(&params, t)).collect();
-    let masses: Vec<f64> = model.bodies.iter().map(|b| b.mass.eval(&params, t)).collect();
+    let masses: Vec<f64> = model
+        .bodies
+        .iter()
+        .map(|b| b.mass.eval(&params, t))
+        .collect();
     let e = sys.evaluate(t, q, v, Parts::ALL).unwrap();
     let vv = DVector::from_column_slice(v);
     let kinetic = 0.5 * vv.dot(&(&e.mass * &vv));
@@ -81,13 +98,24 @@ pub fn mechanical_energy(model: &Model, sys: &mut ModelSystem, t: f64, q: &[f64]
     kinetic + potential
 }
 
+/// (t, q, q̇) at the end of every accepted step.
+pub type Trajectory = Vec<(f64, Vec<f64>, Vec<f64>)>;
+
 /// Integrates with RK4 and returns (t, q, v) of every step.
-pub fn run_rk4(sys: &mut ModelSystem, q0: &[f64], v0: &[f64], t_end: f64, h: f64) -> Vec<(f64, Vec<f64>, Vec<f64>)> {
+pub fn run_rk4(sys: &mut ModelSystem, q0: &[f64], v0: &[f64], t_end: f64, h: f64) -> Trajectory {
     let mut out = Vec::new();
-    integrate_rk4(sys, &Rk4Settings::new(h), 0.0, q0, v0, t_end, |t, q, v, _| {
-        out.push((t, q.to_vec(), v.to_vec()));
-        ControlFlow::Continue(())
-    })
+    integrate_rk4(
+        sys,
+        &Rk4Settings::new(h),
+        0.0,
+        q0,
+        v0,
+        t_end,
+        |t, q, v, _| {
+            out.push((t, q.to_vec(), v.to_vec()));
+            ControlFlow::Continue(())
+        },
+    )
     .unwrap_or_else(|e| panic!("{e}"));
     out
 }
@@ -99,7 +127,7 @@ pub fn run_park(
     q0: &[f64],
     v0: &[f64],
     t_end: f64,
-) -> (Vec<(f64, Vec<f64>, Vec<f64>)>, railmbs_runtime::integrate::IntegrationStats) {
+) -> (Trajectory, railmbs_runtime::integrate::IntegrationStats) {
     let mut out = Vec::new();
     let stats = integrate_park(sys, settings, 0.0, q0, v0, t_end, |t, q, v, _| {
         out.push((t, q.to_vec(), v.to_vec()));
@@ -110,7 +138,12 @@ pub fn run_park(
 }
 
 /// Mass matrix and f = Q − k at a state, through the `MechanicalSystem` view.
-pub fn dynamics(sys: &mut ModelSystem, t: f64, q: &[f64], v: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+pub fn dynamics(
+    sys: &mut ModelSystem,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+) -> (DMatrix<f64>, DVector<f64>) {
     let n = sys.dof();
     let mut m = DMatrix::zeros(n, n);
     let mut f = DVector::zeros(n);
@@ -133,11 +166,15 @@ pub fn symbolic_engine(model: &Model) -> railmbs_runtime::PluginEquations {
     static BUILT: OnceLock<Mutex<HashMap<String, PathBuf>>> = OnceLock::new();
     let hash = model.structural_hash();
     let path = {
-        let mut map = BUILT.get_or_init(|| Mutex::new(HashMap::new())).lock().unwrap();
+        let mut map = BUILT
+            .get_or_init(|| Mutex::new(HashMap::new()))
+            .lock()
+            .unwrap();
         map.entry(hash)
             .or_insert_with(|| {
                 let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins");
-                let opts = railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
+                let opts =
+                    railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
                 railmbs_codegen::build_plugin(model, &opts, Some(cache))
                     .unwrap_or_else(|e| panic!("{}: {e}", model.name))
                     .path
@@ -146,6 +183,7 @@ pub fn symbolic_engine(model: &Model) -> railmbs_runtime::PluginEquations {
     };
     let plugin = railmbs_runtime::Plugin::load_for(&path, model).unwrap_or_else(|e| panic!("{e}"));
     let mut eq = railmbs_runtime::PluginEquations::new(plugin);
-    eq.set_parameters(&model.default_parameter_values()).unwrap();
+    eq.set_parameters(&model.default_parameter_values())
+        .unwrap();
     eq
 }
