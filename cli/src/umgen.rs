@@ -94,7 +94,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         "derivation time        {:.4} s",
         g.derive_time.as_secs_f64()
     );
-    println!("CSE and emission time  {:.4} s", g.emit_time.as_secs_f64());
+    println!("CSE time               {:.4} s", s.cse_time.as_secs_f64());
+    println!(
+        "derive + CSE           {:.4} s",
+        (g.derive_time + s.cse_time).as_secs_f64()
+    );
+    println!("source formatting      {:.4} s", s.format_time.as_secs_f64());
     match built.compile_time {
         Some(t) => println!(
             "compile time           {:.3} s (cache miss)",

@@ -48,6 +48,10 @@ pub struct EmitStats {
     pub source_lines: usize,
     /// Functions emitted.
     pub functions: usize,
+    /// Time of common-subexpression elimination (building the programs).
+    pub cse_time: std::time::Duration,
+    /// Time of writing and formatting the Rust source.
+    pub format_time: std::time::Duration,
 }
 
 /// Identity of the generated plugin.
@@ -402,8 +406,13 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let nb = d.bodies;
     let nc = d.constraints.len();
     let np = header.parameter_names.len();
+    let start = std::time::Instant::now();
     let units = units(d);
-    let mut stats = EmitStats::default();
+    let mut stats = EmitStats {
+        cse_time: start.elapsed(),
+        ..EmitStats::default()
+    };
+    let start = std::time::Instant::now();
     let mut all_roots: Vec<railmbs_cas::ExprId> = Vec::new();
     all_roots.extend(&d.mass);
     all_roots.extend(&d.bias);
@@ -608,5 +617,6 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let file: syn::File = syn::parse2(tokens).expect("generated code parses");
     let text = prettyplease::unparse(&file);
     stats.source_lines = text.lines().count();
+    stats.format_time = start.elapsed();
     (text, stats)
 }

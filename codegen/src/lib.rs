@@ -58,9 +58,9 @@ pub enum CodegenError {
 pub struct Generated {
     pub source: String,
     pub stats: EmitStats,
-    /// Symbolic derivation time.
+    /// Symbolic derivation time (expressions of all outputs).
     pub derive_time: Duration,
-    /// CSE, splitting and source emission time.
+    /// CSE, splitting and source emission time (see `stats` for the parts).
     pub emit_time: Duration,
     pub model_hash: String,
 }
