@@ -1,0 +1,1 @@
+//! Track geometry (being written).
