@@ -1251,8 +1251,13 @@ impl Park {
                             t,
                             reason: format!(
                                 "step size {h:e} s needed by the local error test \
-                                 (error {err:.3e} of tolerance) is below min_step = {:e} s",
-                                s.min_step
+                                 (error {err:.3e} of tolerance) is below min_step = {:e} s; \
+                                 either the solution is singular here, or rtol = {:e} / \
+                                 atol = {:e} ask for more than double precision allows \
+                                 (velocities follow from position differences over the step, \
+                                 so their rounding grows like 1e-16·|q|/h): loosen the \
+                                 tolerances (atol ≥ 1e-9 is a safe floor)",
+                                s.min_step, s.rtol, s.atol
                             ),
                         });
                     }
