@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use nalgebra::{DMatrix, DVector, Matrix3};
+use nalgebra::{DMatrix, DVector};
 use railmbs_runtime::{Equations, Evaluation, Parts};
 
 const STATES: usize = 100;
@@ -23,8 +23,7 @@ fn direct_mass(model: &railmbs_models::Model, params: &[f64], e: &Evaluation) ->
     let n = e.mass.nrows();
     let mut m = DMatrix::zeros(n, n);
     for (j, b) in model.bodies.iter().enumerate() {
-        let i: Vec<f64> = b.inertia.iter().map(|x| x.eval(params, 0.0)).collect();
-        let ib = Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2]);
+        let ib = body_inertia(b, params);
         let a = e.bodies[j].rotation;
         let ig = a * ib * a.transpose();
         let mut mj = DMatrix::zeros(6, 6);
@@ -151,10 +150,7 @@ fn bias_forces_equal_projected_inertia_forces_at_zero_acceleration() {
             let mut k: DVector<f64> = DVector::zeros(n);
             for (j, b) in model.bodies.iter().enumerate() {
                 let m = b.mass.eval(&params, 0.0);
-                let iv: Vec<f64> = b.inertia.iter().map(|x| x.eval(&params, 0.0)).collect();
-                let ib = Matrix3::new(
-                    iv[0], iv[3], iv[4], iv[3], iv[1], iv[5], iv[4], iv[5], iv[2],
-                );
+                let ib = body_inertia(b, &params);
                 let a = e.bodies[j].rotation;
                 let ig = a * ib * a.transpose();
                 let acc = (ep.bodies[j].velocity - em.bodies[j].velocity) / (2.0 * h);

@@ -187,3 +187,9 @@ pub fn symbolic_engine(model: &Model) -> railmbs_runtime::PluginEquations {
         .unwrap();
     eq
 }
+
+/// Inertia tensor of `body` about its centre of mass in the body frame (kg m²).
+pub fn body_inertia(body: &railmbs_models::Body, params: &[f64]) -> nalgebra::Matrix3<f64> {
+    let i: Vec<f64> = body.inertia.iter().map(|x| x.eval(params, 0.0)).collect();
+    nalgebra::Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2])
+}
