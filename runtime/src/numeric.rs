@@ -97,6 +97,9 @@ struct BodyData {
     mass: f64,
     /// Inertia about the centre of mass in the body frame, kg m².
     inertia: Matrix3<f64>,
+    /// Principal moments (ixx, iyy, izz) when the products of inertia are
+    /// zero (the usual case), for a cheaper A I Aᵀ.
+    principal: Option<Vector3<f64>>,
     /// Coordinates on the path from SC0 to this body (inclusive), in order.
     chain: Vec<usize>,
     /// Where this body's own coordinates start in `chain`.
@@ -365,6 +368,7 @@ impl NumericEquations {
                 inertia_expr: b.inertia.clone(),
                 mass: 0.0,
                 inertia: Matrix3::zeros(),
+                principal: None,
                 chain,
                 own_start,
                 steps: (0, 0),
@@ -557,7 +561,10 @@ impl NumericEquations {
                 }
             }
             if with_inertia {
-                self.inertia_global[j] = rotate_tensor(&s.a, &body.inertia);
+                self.inertia_global[j] = match &body.principal {
+                    Some(d) => rotate_principal(&s.a, d),
+                    None => rotate_tensor(&s.a, &body.inertia),
+                };
             }
         }
     }
@@ -596,10 +603,21 @@ impl NumericEquations {
         }
     }
 
-    fn mass_matrix(&mut self, mass: &mut DMatrix<f64>) {
+    /// M by composite bodies; with `bias` (needs the bias accelerations of
+    /// the forward pass) k and with `gravity` Q_g in the same passes.
+    fn mass_matrix(
+        &mut self,
+        mass: &mut DMatrix<f64>,
+        mut bias: Option<&mut DVector<f64>>,
+        mut gravity: Option<&mut DVector<f64>>,
+    ) {
         let nb = self.bodies.len();
-        // Composite bodies: mass, centre of mass, inertia about it (SC0 axes).
+        // Composite bodies: mass, centre of mass, inertia about it (SC0 axes);
+        // with `bias` also the subtree inertia wrenches.
         for j in (0..nb).rev() {
+            if bias.is_some() {
+                self.inertia_wrench(j);
+            }
             let body = &self.bodies[j];
             let children = &self.children[j];
             let mut m = body.mass;
@@ -669,8 +687,35 @@ impl NumericEquations {
                     ms[k + i * n] = value;
                     ms[i + k * n] = value;
                 }
+                if let Some(bias) = bias.as_deref_mut() {
+                    let (f, t) = (&self.subtree_force[b], &self.subtree_moment[b]);
+                    bias[i] = self.project_wrench(i, f, t, &self.states[b].r);
+                }
+                if let Some(gravity) = gravity.as_deref_mut() {
+                    // The weight of the subtree acts at its centre of mass.
+                    let weight = cm * self.gravity;
+                    gravity[i] = self.project_wrench(i, &weight, &Vector3::zeros(), &cc);
+                }
             }
         }
+    }
+
+    /// Subtree inertia wrench of body `j` at q̈ = 0 (its children's already
+    /// accumulated): force Σ m a⁰ and moment about r_j of the Newton–Euler
+    /// terms (m a⁰, I α⁰ + ω × I ω).
+    #[inline(always)]
+    fn inertia_wrench(&mut self, j: usize) {
+        let s = &self.states[j];
+        let i = &self.inertia_global[j];
+        let mut f = self.bodies[j].mass * s.acc0;
+        let mut n = i * s.alpha0 + s.w.cross(&(i * s.w));
+        for &c in &self.children[j] {
+            let fc = self.subtree_force[c];
+            f += fc;
+            n += self.subtree_moment[c] + (self.states[c].r - s.r).cross(&fc);
+        }
+        self.subtree_force[j] = f;
+        self.subtree_moment[j] = n;
     }
 
     /// Projection of the subtree wrenches (about each body's centre of mass)
@@ -849,6 +894,17 @@ fn rotate_tensor(a: &Matrix3<f64>, i: &Matrix3<f64>) -> Matrix3<f64> {
     Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
 }
 
+/// A diag(d) Aᵀ: entry (r, c) is Σ_k d_k A_rk A_ck.
+#[inline(always)]
+fn rotate_principal(a: &Matrix3<f64>, d: &Vector3<f64>) -> Matrix3<f64> {
+    let e = |r: usize, c: usize| {
+        d.x * a[(r, 0)] * a[(c, 0)] + d.y * a[(r, 1)] * a[(c, 1)] + d.z * a[(r, 2)] * a[(c, 2)]
+    };
+    let (xx, yy, zz) = (e(0, 0), e(1, 1), e(2, 2));
+    let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+}
+
 impl Equations for NumericEquations {
     fn engine_name(&self) -> &str {
         "numeric"
@@ -884,6 +940,8 @@ impl Equations for NumericEquations {
                 i[k] = finite(e.eval(p, 0.0), || format!("inertia of body #{j}"))?;
             }
             body.inertia = Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2]);
+            body.principal =
+                (i[3] == 0.0 && i[4] == 0.0 && i[5] == 0.0).then(|| Vector3::new(i[0], i[1], i[2]));
         }
         self.compile_steps()?;
         let p = &self.params;
@@ -947,47 +1005,30 @@ impl Equations for NumericEquations {
             }
         }
         if parts.mass {
-            self.mass_matrix(&mut out.mass);
-        }
-        if parts.bias {
-            // Inertia wrenches at q̈ = 0: (m a⁰, I α⁰ + ω × I ω) (Newton–Euler).
-            let (states, inertia, bodies) = (&self.states, &self.inertia_global, &self.bodies);
-            accumulate_wrenches(
-                states,
-                &self.children,
-                |j| {
-                    let s = &states[j];
-                    let i = &inertia[j];
-                    (
-                        bodies[j].mass * s.acc0,
-                        i * s.alpha0 + s.w.cross(&(i * s.w)),
-                    )
-                },
-                &mut self.subtree_force,
-                &mut self.subtree_moment,
+            // k and Q_g come with M from the same composite-body passes.
+            self.mass_matrix(
+                &mut out.mass,
+                parts.bias.then_some(&mut out.bias),
+                parts.gravity.then_some(&mut out.gravity),
             );
-            self.project_subtree_wrenches(&mut out.bias);
-        }
-        if parts.gravity && parts.mass {
-            // The composite bodies of M give Q_g directly: the weight m_c g of
-            // each subtree acts at its centre of mass c.
-            for (b, body) in self.bodies.iter().enumerate() {
-                let weight = self.composite_mass[b] * self.gravity;
-                let c = &self.composite_center[b];
-                for &i in &body.chain[body.own_start..] {
-                    out.gravity[i] = self.project_wrench(i, &weight, &Vector3::zeros(), c);
+        } else {
+            if parts.bias {
+                for j in (0..self.bodies.len()).rev() {
+                    self.inertia_wrench(j);
                 }
+                self.project_subtree_wrenches(&mut out.bias);
             }
-        } else if parts.gravity {
-            let (bodies, g) = (&self.bodies, self.gravity);
-            accumulate_wrenches(
-                &self.states,
-                &self.children,
-                |j| (bodies[j].mass * g, Vector3::zeros()),
-                &mut self.subtree_force,
-                &mut self.subtree_moment,
-            );
-            self.project_subtree_wrenches(&mut out.gravity);
+            if parts.gravity {
+                let (bodies, g) = (&self.bodies, self.gravity);
+                accumulate_wrenches(
+                    &self.states,
+                    &self.children,
+                    |j| (bodies[j].mass * g, Vector3::zeros()),
+                    &mut self.subtree_force,
+                    &mut self.subtree_moment,
+                );
+                self.project_subtree_wrenches(&mut out.gravity);
+            }
         }
         if parts.jacobians {
             out.jacobians.fill(0.0);
