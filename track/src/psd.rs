@@ -1,0 +1,329 @@
+//! Stochastic irregularities from published power spectral densities (PSD),
+//! generated as a sum of harmonics with random phases.
+//!
+//! All PSDs here are **one-sided in the angular wavenumber** Ω (rad/m): the
+//! variance of the irregularity over a band is ∫ S(Ω) dΩ, S in m²/(rad/m). (A PSD
+//! per cyclic wavenumber f = Ω/2π, in m²/(1/m), is 2π S.)
+//!
+//! **ERRI / ORE B176** (ORE B176 RP1, 1989; as used e.g. in GENSYS `TRC_IPSD`,
+//! whose tabulated "ORE B176 high level" values at 50 m and 10 m wavelength
+//! this formula reproduces to 4 digits):
+//! - vertical level and alignment: S(Ω) = A Ωc² / ((Ω² + Ωr²)(Ω² + Ωc²));
+//! - cross-level, as an angle over the half contact distance b:
+//!   S(Ω) = (A_v/b²) Ωc² Ω² / ((Ω² + Ωr²)(Ω² + Ωc²)(Ω² + Ωs²)); here as a rail
+//!   height difference over 2b, i.e. multiplied by (2b)², which removes b;
+//! - Ωc = 0.8246, Ωr = 0.0206, Ωs = 0.4380 rad/m; low level A_v = 5.9233e-7,
+//!   A_a = 3.3651e-7 m·rad; high level A_v = 1.0800e-6, A_a = 6.1250e-7 m·rad.
+//!
+//! **FRA classes 1–6** (Hamid & Yang, "Analytical descriptions of track geometry
+//! variations", DOT/FRA/ORD-83/03.1, 1983, as tabulated in Garg & Dukkipati,
+//! *Dynamics of Railway Vehicle Systems*, 1984):
+//! - vertical profile: S(Ω) = k A_v Ωc² / (Ω² (Ω² + Ωc²));
+//! - alignment: S(Ω) = k A_a Ωc² / (Ω² (Ω² + Ωc²));
+//! - k = 0.25, Ωc = 0.8245 rad/m, A in cm²·rad/m (converted here to m²):
+//!   A_v = 1.2107, 1.0181, 0.6816, 0.5376, 0.2095, 0.0339 and
+//!   A_a = 3.3634, 1.2107, 0.4128, 0.3027, 0.0762, 0.0339 for classes 1…6.
+//!
+//! Gauge spectra (and FRA cross-level) are not provided: their published forms
+//! could not be confirmed from two sources; asking for them is an error.
+
+use std::f64::consts::PI;
+
+use crate::alignment::{GL8_W, GL8_X};
+use crate::error::{TrackError, check_param, invalid};
+use crate::irregularity::{Component, MeasuredIrregularity, RailDeviation};
+
+/// ORE B176 Ωc, rad/m.
+pub const ERRI_OMEGA_C: f64 = 0.8246;
+/// ORE B176 Ωr, rad/m.
+pub const ERRI_OMEGA_R: f64 = 0.0206;
+/// ORE B176 Ωs, rad/m.
+pub const ERRI_OMEGA_S: f64 = 0.4380;
+/// ORE B176 A_v (low, high), m·rad.
+pub const ERRI_A_V: [f64; 2] = [5.9233e-7, 1.0800e-6];
+/// ORE B176 A_a (low, high), m·rad.
+pub const ERRI_A_A: [f64; 2] = [3.3651e-7, 6.1250e-7];
+/// FRA k.
+pub const FRA_K: f64 = 0.25;
+/// FRA Ωc, rad/m.
+pub const FRA_OMEGA_C: f64 = 0.8245;
+/// FRA A_v for classes 1..6, cm²·rad/m.
+pub const FRA_A_V: [f64; 6] = [1.2107, 1.0181, 0.6816, 0.5376, 0.2095, 0.0339];
+/// FRA A_a for classes 1..6, cm²·rad/m.
+pub const FRA_A_A: [f64; 6] = [3.3634, 1.2107, 0.4128, 0.3027, 0.0762, 0.0339];
+
+/// A published irregularity spectrum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PsdModel {
+    /// ERRI (ORE B176) low level.
+    ErriLow,
+    /// ERRI (ORE B176) high level.
+    ErriHigh,
+    /// FRA track class 1..=6 (6 is the best).
+    Fra(u8),
+}
+
+/// One-sided PSD S(Ω) of `component` at angular wavenumber `omega` (rad/m, > 0),
+/// m²/(rad/m).
+pub fn psd(model: PsdModel, component: Component, omega: f64) -> Result<f64, TrackError> {
+    check_param("wavenumber Ω", omega, true)?;
+    let o2 = omega * omega;
+    match model {
+        PsdModel::ErriLow | PsdModel::ErriHigh => {
+            let lvl = usize::from(model == PsdModel::ErriHigh);
+            let (c2, r2, s2) = (
+                ERRI_OMEGA_C * ERRI_OMEGA_C,
+                ERRI_OMEGA_R * ERRI_OMEGA_R,
+                ERRI_OMEGA_S * ERRI_OMEGA_S,
+            );
+            let base = c2 / ((o2 + r2) * (o2 + c2));
+            match component {
+                Component::Vertical => Ok(ERRI_A_V[lvl] * base),
+                Component::Lateral => Ok(ERRI_A_A[lvl] * base),
+                Component::CrossLevel => Ok(4.0 * ERRI_A_V[lvl] * base * o2 / (o2 + s2)),
+                Component::Gauge => Err(invalid(
+                    "PSD component",
+                    "the ERRI (ORE B176) gauge spectrum is not provided",
+                )),
+            }
+        }
+        PsdModel::Fra(class) => {
+            if !(1..=6).contains(&class) {
+                return Err(invalid("FRA track class", format!("{class} must be 1..=6")));
+            }
+            let i = usize::from(class - 1);
+            let c2 = FRA_OMEGA_C * FRA_OMEGA_C;
+            let base = FRA_K * c2 / (o2 * (o2 + c2)) * 1e-4; // cm² → m²
+            match component {
+                Component::Vertical => Ok(FRA_A_V[i] * base),
+                Component::Lateral => Ok(FRA_A_A[i] * base),
+                Component::Gauge | Component::CrossLevel => Err(invalid(
+                    "PSD component",
+                    "FRA gauge and cross-level spectra are not provided",
+                )),
+            }
+        }
+    }
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): a small, seedable, portable PRNG.
+#[derive(Debug, Clone)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    /// Seeds the generator.
+    pub fn new(seed: u64) -> Self {
+        SplitMix64(seed)
+    }
+    /// Next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1) with 53 random bits.
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// What to generate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StochasticSpec {
+    /// The spectrum.
+    pub model: PsdModel,
+    /// The component it drives.
+    pub component: Component,
+    /// Shortest wavelength of the band, m.
+    pub wavelength_min: f64,
+    /// Longest wavelength of the band, m.
+    pub wavelength_max: f64,
+    /// Number of harmonics N. The realization repeats after 2π/ΔΩ =
+    /// N·λmin·λmax/(λmax − λmin) m; choose N so that this exceeds the track.
+    pub harmonics: usize,
+    /// PRNG seed of the phases.
+    pub seed: u64,
+    /// Start of the extent, m.
+    pub start: f64,
+    /// End of the extent, m.
+    pub end: f64,
+    /// Length of the sin² fade-in after `start` and fade-out before `end`, m
+    /// (0: switched on and off abruptly).
+    pub fade: f64,
+}
+
+/// A generated realization Σ a_k cos(Ω_k s + φ_k).
+///
+/// The band [2π/λmax, 2π/λmin] is cut into N equal bins of width ΔΩ; Ω_k is the
+/// bin centre and a_k = √(2 ∫_bin S dΩ) (8-point Gauss–Legendre per bin), so the
+/// mean square Σ a_k²/2 equals the integral of the PSD over the band. Phases
+/// φ_k are uniform in [0, 2π) from [`SplitMix64`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StochasticIrregularity {
+    component: Component,
+    omega: Vec<f64>,
+    amplitude: Vec<f64>,
+    phase: Vec<f64>,
+    start: f64,
+    end: f64,
+    fade: f64,
+}
+
+impl StochasticIrregularity {
+    /// Generates a realization.
+    pub fn generate(spec: &StochasticSpec) -> Result<Self, TrackError> {
+        check_param("shortest wavelength", spec.wavelength_min, true)?;
+        check_param("longest wavelength", spec.wavelength_max, true)?;
+        check_param("stochastic irregularity start", spec.start, false)?;
+        check_param("stochastic irregularity end", spec.end, false)?;
+        check_param("stochastic irregularity fade", spec.fade, false)?;
+        if spec.wavelength_max <= spec.wavelength_min {
+            return Err(invalid(
+                "wavelength band",
+                format!(
+                    "longest {} m must exceed shortest {} m",
+                    spec.wavelength_max, spec.wavelength_min
+                ),
+            ));
+        }
+        if spec.harmonics == 0 || spec.harmonics > 1_000_000 {
+            return Err(invalid(
+                "number of harmonics",
+                format!("{} must be in 1..=1000000", spec.harmonics),
+            ));
+        }
+        if spec.end <= spec.start {
+            return Err(invalid(
+                "stochastic irregularity extent",
+                format!("end {} m must be after start {} m", spec.end, spec.start),
+            ));
+        }
+        if spec.fade < 0.0 || 2.0 * spec.fade > spec.end - spec.start {
+            return Err(invalid(
+                "stochastic irregularity fade",
+                format!("{} m must be in [0, (end − start)/2]", spec.fade),
+            ));
+        }
+        // Fails early on an unsupported component.
+        psd(spec.model, spec.component, 1.0)?;
+        let o1 = 2.0 * PI / spec.wavelength_max;
+        let o2 = 2.0 * PI / spec.wavelength_min;
+        let n = spec.harmonics;
+        let d = (o2 - o1) / n as f64;
+        let mut rng = SplitMix64::new(spec.seed);
+        let mut omega = Vec::with_capacity(n);
+        let mut amplitude = Vec::with_capacity(n);
+        let mut phase = Vec::with_capacity(n);
+        for k in 0..n {
+            let c = o1 + (k as f64 + 0.5) * d;
+            let mut integral = 0.0;
+            for j in 0..4 {
+                for sgn in [-1.0, 1.0] {
+                    integral +=
+                        GL8_W[j] * psd(spec.model, spec.component, c + sgn * GL8_X[j] * 0.5 * d)?;
+                }
+            }
+            integral *= 0.5 * d;
+            omega.push(c);
+            amplitude.push((2.0 * integral).sqrt());
+            phase.push(2.0 * PI * rng.next_f64());
+        }
+        Ok(StochasticIrregularity {
+            component: spec.component,
+            omega,
+            amplitude,
+            phase,
+            start: spec.start,
+            end: spec.end,
+            fade: spec.fade,
+        })
+    }
+
+    /// The driven component.
+    pub fn component(&self) -> Component {
+        self.component
+    }
+
+    /// Wavenumbers Ω_k (rad/m), amplitudes a_k (m) and phases φ_k (rad).
+    pub fn harmonics(&self) -> (&[f64], &[f64], &[f64]) {
+        (&self.omega, &self.amplitude, &self.phase)
+    }
+
+    /// Mean square Σ a_k²/2 of the unfaded signal, m².
+    pub fn variance(&self) -> f64 {
+        self.amplitude.iter().map(|a| 0.5 * a * a).sum()
+    }
+
+    /// The unfaded signal and its s-derivative at `s` (ignores the extent).
+    pub fn signal(&self, s: f64) -> (f64, f64) {
+        let (mut v, mut dv) = (0.0, 0.0);
+        for k in 0..self.omega.len() {
+            let (sn, cs) = (self.omega[k] * s + self.phase[k]).sin_cos();
+            v += self.amplitude[k] * cs;
+            dv -= self.amplitude[k] * self.omega[k] * sn;
+        }
+        (v, dv)
+    }
+
+    /// Window (fade) and its derivative.
+    fn window(&self, s: f64) -> (f64, f64) {
+        if s < self.start || s > self.end {
+            return (0.0, 0.0);
+        }
+        if self.fade > 0.0 {
+            let h = 0.5 * PI / self.fade;
+            let (u, sign) = if s - self.start < self.fade {
+                (s - self.start, 1.0)
+            } else if self.end - s < self.fade {
+                (self.end - s, -1.0)
+            } else {
+                return (1.0, 0.0);
+            };
+            let (sn, cs) = (h * u).sin_cos();
+            return (sn * sn, sign * 2.0 * sn * cs * h);
+        }
+        (1.0, 0.0)
+    }
+
+    pub(crate) fn eval(&self, s: f64) -> (RailDeviation, RailDeviation) {
+        let (w, dw) = self.window(s);
+        if w == 0.0 && dw == 0.0 {
+            return Default::default();
+        }
+        let (v, dv) = self.signal(s);
+        (
+            RailDeviation::from_component(self.component, w * v),
+            RailDeviation::from_component(self.component, dw * v + w * dv),
+        )
+    }
+
+    /// Samples the realization (with its fade) every `ds` m over its extent into
+    /// a table, for fast evaluation by linear interpolation. The interpolation
+    /// error at wavelength λ is at most (π ds/λ)²/2 of that harmonic's amplitude
+    /// (1.2 % at ds = λ/20).
+    pub fn sampled(&self, ds: f64) -> Result<MeasuredIrregularity, TrackError> {
+        check_param("sampling step", ds, true)?;
+        let n = ((self.end - self.start) / ds).ceil() as usize;
+        if n > 50_000_000 {
+            return Err(invalid(
+                "sampling step",
+                format!("{ds} m gives too many samples"),
+            ));
+        }
+        let mut s = Vec::with_capacity(n + 1);
+        let mut v = Vec::with_capacity(n + 1);
+        for i in 0..=n {
+            let x = (self.start + i as f64 * ds).min(self.end);
+            if let Some(&last) = s.last()
+                && x <= last
+            {
+                break;
+            }
+            s.push(x);
+            v.push(self.eval(x).0);
+        }
+        MeasuredIrregularity::from_samples(s, v)
+    }
+}
