@@ -88,6 +88,41 @@
 //! )
 //! ```
 //!
+//! ### Friction, contact and nonlinear force elements
+//!
+//! Besides `Spring`, `Linear6` and `Applied` (above), `forces` accepts the
+//! elements of the seed paper's Sect. 3 (fields with a default may be left out;
+//! every number may be an expression over parameters):
+//!
+//! ```text
+//! // Point–plane contact: points of `body` against the plane of `plane_body`
+//! // through `origin` with outward `normal` (that body's frame). Normal force
+//! // N = max(0, c·δ + d·δ̇) per point (no adhesion); tangential Coulomb friction:
+//! // sticking to an anchor by ct, dt (default c, d) up to mu0·N, sliding at mu·N.
+//! PointPlane(name: "feet", body: "block", points: [(0.1, 0.1, -0.05), (-0.1, 0.1, -0.05)],
+//!            plane_body: "ground", origin: (0, 0, 0), normal: (0, 0, 1),   // defaults
+//!            c: 1e6, d: 500, ct: 1e6, dt: 500, mu0: 0.3, mu: 0.25),      // mu0 default mu
+//! // Bipolar Coulomb friction: sticking F = f0 + c (x − x0) + d ẋ (f0, x0 stored
+//! // when sticking starts) until |F| reaches `limit` (F0); then sliding at
+//! // `sliding` (default `limit`) against the relative velocity.
+//! Coulomb(name: "wedge", body1: "frame", point1: (0, 0, 0), body2: "bolster", point2: (0, 0, 0),
+//!         c: 1e7, d: 1e3, limit: 5000, sliding: 4000),
+//! // Load-dependent friction (Fig. 3): spring c1 in series with spring c2 in
+//! // parallel with friction mu·|force in c2| (static mu0, default mu; mu0 < 1).
+//! LoadFriction(name: "snubber", body1: "a", body2: "b", c1: 2e6, c2: 1e6, mu0: 0.3, mu: 0.2, x0: 0.5),
+//! // Tabulated characteristic F(x − x0) (piecewise linear, extended linearly
+//! // beyond the end rows; deflection m increasing, force N) plus d·ẋ. A bump stop:
+//! Tabulated(name: "stop", body1: "a", body2: "b", table: [(-0.02, -2e4), (-0.01, 0), (0.01, 0), (0.02, 2e4)],
+//!           d: 100, x0: 0.5),
+//! ```
+//!
+//! As for `Spring`, x is the distance of the two points and a positive force
+//! pulls them together. Checked with the default parameters: stiffnesses (`c`,
+//! `ct`, `c1`, `c2`) positive, dampings not negative, 0 ≤ `mu` ≤ `mu0`,
+//! 0 ≤ `sliding` ≤ `limit`, a non-zero `normal`, at least one contact point,
+//! points and plane on different bodies, at least two table rows with
+//! increasing deflections.
+//!
 //! ### Numbers and expressions
 //!
 //! Every numeric field accepts an integer, a float or an expression string with

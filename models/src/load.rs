@@ -56,13 +56,22 @@ pub(crate) fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError)
 
 const BODY: &[&str] = &["Body"];
 const CUT: &[&str] = &["CutJoint"];
-const FORCE: &[&str] = &["Spring", "Linear6", "Applied"];
+const FORCE: &[&str] = &[
+    "Spring",
+    "Linear6",
+    "Applied",
+    "PointPlane",
+    "Coulomb",
+    "LoadFriction",
+    "Tabulated",
+];
 
 fn kind_of(ctor: &str) -> &'static str {
     match ctor {
         "Body" => "body",
         "CutJoint" => "cut joint",
-        "Spring" | "Linear6" | "Applied" => "force",
+        "Spring" | "Linear6" | "Applied" | "PointPlane" | "Coulomb" | "LoadFriction"
+        | "Tabulated" => "force",
         "Scenario" => "scenario",
         "Model" => "model",
         _ => "element",
@@ -935,6 +944,44 @@ impl Cx<'_> {
         out
     }
 
+    /// With default parameters: `e` > 0 (a stiffness).
+    fn check_positive(&mut self, w: &Where, key: &str, e: &Expr) {
+        if let Some(d) = &self.defaults {
+            let x = e.eval(d, 0.0);
+            if x.is_finite() && x <= 0.0 {
+                self.err(w, Some(key), None, format!("{key} must be positive, got {x}"));
+            }
+        }
+    }
+
+    /// With default parameters: `e` ≥ 0 (a damping).
+    fn check_non_negative(&mut self, w: &Where, key: &str, e: &Expr) {
+        if let Some(d) = &self.defaults {
+            let x = e.eval(d, 0.0);
+            if x.is_finite() && x < 0.0 {
+                self.err(w, Some(key), None, format!("{key} must not be negative, got {x}"));
+            }
+        }
+    }
+
+    /// With default parameters: 0 ≤ sliding ≤ static (friction coefficients
+    /// or forces).
+    fn check_friction(&mut self, w: &Where, key: &str, sliding: &Expr, key0: &str, stat: &Expr) {
+        if let Some(d) = &self.defaults {
+            let (s, s0) = (sliding.eval(d, 0.0), stat.eval(d, 0.0));
+            if s.is_finite() && s < 0.0 {
+                self.err(w, Some(key), None, format!("{key} must not be negative, got {s}"));
+            } else if s.is_finite() && s0.is_finite() && s > s0 {
+                self.err(
+                    w,
+                    Some(key),
+                    None,
+                    format!("{key} = {s} must not exceed {key0} = {s0}"),
+                );
+            }
+        }
+    }
+
     fn forces(&mut self, raw: &RawModel, lookup: &Lookup) -> Vec<ForceElement> {
         let mut out = Vec::new();
         for (i, f) in raw.forces.iter().enumerate() {
@@ -1001,6 +1048,211 @@ impl Cx<'_> {
                         stiffness,
                         damping,
                         preload,
+                    }
+                }
+                RawForce::PointPlane {
+                    body,
+                    points,
+                    plane_body,
+                    origin,
+                    normal,
+                    c,
+                    d,
+                    ct,
+                    dt,
+                    mu0,
+                    mu,
+                    ..
+                } => {
+                    let body_ref = self.body_ref(&w, "body", body, lookup);
+                    let plane_ref = self.body_ref(&w, "plane_body", plane_body, lookup);
+                    if body_ref == plane_ref && body == plane_body {
+                        self.err(
+                            &w,
+                            Some("plane_body"),
+                            None,
+                            "the plane must belong to another body than the points".into(),
+                        );
+                    }
+                    if points.is_empty() {
+                        self.err(&w, Some("points"), None, "needs at least one point".into());
+                    }
+                    let points: Vec<[Expr; 3]> = points
+                        .iter()
+                        .enumerate()
+                        .map(|(k, p)| self.vec3(&w, &format!("points[{k}]"), p, false))
+                        .collect();
+                    let normal_e = self.vec3(&w, "normal", normal, false);
+                    if let Some(defs) = &self.defaults {
+                        let len2: f64 = normal_e.iter().map(|e| e.eval(defs, 0.0).powi(2)).sum();
+                        if len2.is_finite() && len2 == 0.0 {
+                            self.err(&w, Some("normal"), None, "normal must not be zero".into());
+                        }
+                    }
+                    let stiffness = self.expr(&w, "c", "c", c, false);
+                    let damping = self.expr(&w, "d", "d", d, false);
+                    let tangential_stiffness = match ct {
+                        Some(v) => self.expr(&w, "ct", "ct", v, false),
+                        None => stiffness.clone(),
+                    };
+                    let tangential_damping = match dt {
+                        Some(v) => self.expr(&w, "dt", "dt", v, false),
+                        None => damping.clone(),
+                    };
+                    let mu = self.expr(&w, "mu", "mu", mu, false);
+                    let mu_static = match mu0 {
+                        Some(v) => self.expr(&w, "mu0", "mu0", v, false),
+                        None => mu.clone(),
+                    };
+                    self.check_positive(&w, "c", &stiffness);
+                    self.check_positive(&w, "ct", &tangential_stiffness);
+                    self.check_non_negative(&w, "d", &damping);
+                    self.check_non_negative(&w, "dt", &tangential_damping);
+                    self.check_friction(&w, "mu", &mu, "mu0", &mu_static);
+                    ForceKind::PointPlane {
+                        body: body_ref,
+                        points,
+                        plane_body: plane_ref,
+                        origin: self.vec3(&w, "origin", origin, false),
+                        normal: normal_e,
+                        stiffness,
+                        damping,
+                        tangential_stiffness,
+                        tangential_damping,
+                        mu_static,
+                        mu,
+                    }
+                }
+                RawForce::Coulomb {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    c,
+                    d,
+                    limit,
+                    sliding,
+                    ..
+                } => {
+                    let stiffness = self.expr(&w, "c", "c", c, false);
+                    let damping = self.expr(&w, "d", "d", d, false);
+                    let static_limit = self.expr(&w, "limit", "limit", limit, false);
+                    let sliding_force = match sliding {
+                        Some(v) => self.expr(&w, "sliding", "sliding", v, false),
+                        None => static_limit.clone(),
+                    };
+                    self.check_positive(&w, "c", &stiffness);
+                    self.check_non_negative(&w, "d", &damping);
+                    self.check_friction(&w, "sliding", &sliding_force, "limit", &static_limit);
+                    ForceKind::Coulomb {
+                        body1: self.body_ref(&w, "body1", body1, lookup),
+                        point1: self.vec3(&w, "point1", point1, false),
+                        body2: self.body_ref(&w, "body2", body2, lookup),
+                        point2: self.vec3(&w, "point2", point2, false),
+                        stiffness,
+                        damping,
+                        static_limit,
+                        sliding_force,
+                    }
+                }
+                RawForce::LoadFriction {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    c1,
+                    c2,
+                    mu0,
+                    mu,
+                    x0,
+                    ..
+                } => {
+                    let c1 = self.expr(&w, "c1", "c1", c1, false);
+                    let c2 = self.expr(&w, "c2", "c2", c2, false);
+                    let mu = self.expr(&w, "mu", "mu", mu, false);
+                    let mu_static = match mu0 {
+                        Some(v) => self.expr(&w, "mu0", "mu0", v, false),
+                        None => mu.clone(),
+                    };
+                    self.check_positive(&w, "c1", &c1);
+                    self.check_positive(&w, "c2", &c2);
+                    self.check_friction(&w, "mu", &mu, "mu0", &mu_static);
+                    if let Some(defs) = &self.defaults {
+                        let m0 = mu_static.eval(defs, 0.0);
+                        if m0.is_finite() && m0 >= 1.0 {
+                            self.err(
+                                &w,
+                                Some("mu0"),
+                                None,
+                                format!("mu0 must be below 1 (the unloading branch would lock), got {m0}"),
+                            );
+                        }
+                    }
+                    ForceKind::LoadFriction {
+                        body1: self.body_ref(&w, "body1", body1, lookup),
+                        point1: self.vec3(&w, "point1", point1, false),
+                        body2: self.body_ref(&w, "body2", body2, lookup),
+                        point2: self.vec3(&w, "point2", point2, false),
+                        c1,
+                        c2,
+                        mu_static,
+                        mu,
+                        free_length: self.expr(&w, "x0", "x0", x0, false),
+                    }
+                }
+                RawForce::Tabulated {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    table,
+                    d,
+                    x0,
+                    ..
+                } => {
+                    if table.len() < 2 {
+                        self.err(
+                            &w,
+                            Some("table"),
+                            None,
+                            format!("table needs at least 2 rows, got {}", table.len()),
+                        );
+                    }
+                    let rows: Vec<(Expr, Expr)> = table
+                        .iter()
+                        .enumerate()
+                        .map(|(k, (x, f))| {
+                            (
+                                self.expr(&w, &format!("table[{k}].deflection"), "table", x, false),
+                                self.expr(&w, &format!("table[{k}].force"), "table", f, false),
+                            )
+                        })
+                        .collect();
+                    if let Some(defs) = self.defaults.clone() {
+                        let xs: Vec<f64> = rows.iter().map(|(x, _)| x.eval(&defs, 0.0)).collect();
+                        if let Some(k) = (1..xs.len()).find(|&k| !(xs[k] > xs[k - 1])) {
+                            self.err(
+                                &w,
+                                Some("table"),
+                                None,
+                                format!(
+                                    "table deflections must increase: row {k} has {} after {}",
+                                    xs[k],
+                                    xs[k - 1]
+                                ),
+                            );
+                        }
+                    }
+                    let damping = self.expr(&w, "d", "d", d, false);
+                    self.check_non_negative(&w, "d", &damping);
+                    ForceKind::Tabulated {
+                        body1: self.body_ref(&w, "body1", body1, lookup),
+                        point1: self.vec3(&w, "point1", point1, false),
+                        body2: self.body_ref(&w, "body2", body2, lookup),
+                        point2: self.vec3(&w, "point2", point2, false),
+                        table: rows,
+                        damping,
+                        free_length: self.expr(&w, "x0", "x0", x0, false),
                     }
                 }
                 RawForce::Applied {

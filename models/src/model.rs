@@ -182,6 +182,84 @@ pub enum ForceKind {
         /// Static preload wrench (N, N m), in frame 1.
         preload: [Expr; 6],
     },
+    /// Point–plane contact (paper Sect. 3.3): points fixed to `body` against
+    /// the plane through `origin` with outward `normal` fixed to `plane_body`
+    /// (both in that body's frame). Penetration δ ≥ 0 gives the normal force
+    /// N = max(0, c δ + d δ̇) (no adhesion); the tangential force is Coulomb
+    /// friction with sticking (the point tied to an anchor by ct, dt) up to
+    /// μ0 N, and sliding at μ N.
+    PointPlane {
+        body: BodyRef,
+        /// Contact points in the frame of `body`, m.
+        points: Vec<[Expr; 3]>,
+        plane_body: BodyRef,
+        /// A point of the plane, m.
+        origin: [Expr; 3],
+        /// Normal pointing out of the plane's solid side (any length > 0).
+        normal: [Expr; 3],
+        /// Normal stiffness per point, N/m.
+        stiffness: Expr,
+        /// Normal damping per point, N s/m.
+        damping: Expr,
+        /// Tangential stiffness of the sticking anchor, N/m.
+        tangential_stiffness: Expr,
+        /// Tangential damping of the sticking anchor, N s/m.
+        tangential_damping: Expr,
+        /// Static friction coefficient μ0 (≥ μ).
+        mu_static: Expr,
+        /// Sliding friction coefficient μ (≥ 0).
+        mu: Expr,
+    },
+    /// Bipolar Coulomb friction (paper Sect. 3.1) between two points: sticking,
+    /// F = f0 + c (x − x0) + d ẋ with f0, x0 stored when sticking begins,
+    /// until |F| reaches the static limit; then sliding, F = F_s sign(ẋ).
+    /// Positive F pulls the points together.
+    Coulomb {
+        body1: BodyRef,
+        point1: [Expr; 3],
+        body2: BodyRef,
+        point2: [Expr; 3],
+        /// Sticking stiffness, N/m.
+        stiffness: Expr,
+        /// Sticking damping, N s/m.
+        damping: Expr,
+        /// Static limit F0, N.
+        static_limit: Expr,
+        /// Sliding force F_s (≤ F0), N.
+        sliding_force: Expr,
+    },
+    /// Load-dependent friction (paper Sect. 3.1, Fig. 3): spring c1 in series
+    /// with spring c2 in parallel with friction proportional to the force in
+    /// c2 (static μ0, sliding μ). x is the distance minus `free_length`.
+    LoadFriction {
+        body1: BodyRef,
+        point1: [Expr; 3],
+        body2: BodyRef,
+        point2: [Expr; 3],
+        /// N/m.
+        c1: Expr,
+        /// N/m.
+        c2: Expr,
+        mu_static: Expr,
+        mu: Expr,
+        /// m.
+        free_length: Expr,
+    },
+    /// Tabulated force–deflection characteristic (bump stops): F = f(x − x0)
+    /// + d ẋ, f piecewise linear through the rows (deflection m, force N),
+    /// extended linearly beyond the first and last rows.
+    Tabulated {
+        body1: BodyRef,
+        point1: [Expr; 3],
+        body2: BodyRef,
+        point2: [Expr; 3],
+        /// (deflection m, force N), deflection increasing.
+        table: Vec<(Expr, Expr)>,
+        /// N s/m.
+        damping: Expr,
+        /// m.
+        free_length: Expr,
+    },
     /// An applied force and torque on one body; expressions may depend on `t`.
     Applied {
         body: usize,

@@ -156,6 +156,14 @@ fn default_gravity() -> Vec3 {
     (Value::Num(0.0), Value::Num(0.0), Value::Num(-9.81))
 }
 
+fn ground_name() -> String {
+    "ground".into()
+}
+
+fn unit_z() -> Vec3 {
+    (Value::Num(0.0), Value::Num(0.0), Value::Num(1.0))
+}
+
 fn zero_matrix() -> RawMatrix6 {
     RawMatrix6::Diag(Default::default())
 }
@@ -422,6 +430,73 @@ pub(crate) enum RawForce {
         #[serde(default)]
         preload: Vec6,
     },
+    PointPlane {
+        name: String,
+        body: String,
+        points: Vec<Vec3>,
+        #[serde(default = "ground_name")]
+        plane_body: String,
+        #[serde(default = "zero3")]
+        origin: Vec3,
+        #[serde(default = "unit_z")]
+        normal: Vec3,
+        c: Value,
+        #[serde(default)]
+        d: Value,
+        #[serde(default)]
+        ct: Option<Value>,
+        #[serde(default)]
+        dt: Option<Value>,
+        #[serde(default)]
+        mu0: Option<Value>,
+        #[serde(default)]
+        mu: Value,
+    },
+    Coulomb {
+        name: String,
+        body1: String,
+        #[serde(default = "zero3")]
+        point1: Vec3,
+        body2: String,
+        #[serde(default = "zero3")]
+        point2: Vec3,
+        c: Value,
+        #[serde(default)]
+        d: Value,
+        limit: Value,
+        #[serde(default)]
+        sliding: Option<Value>,
+    },
+    LoadFriction {
+        name: String,
+        body1: String,
+        #[serde(default = "zero3")]
+        point1: Vec3,
+        body2: String,
+        #[serde(default = "zero3")]
+        point2: Vec3,
+        c1: Value,
+        c2: Value,
+        #[serde(default)]
+        mu0: Option<Value>,
+        mu: Value,
+        #[serde(default)]
+        x0: Value,
+    },
+    Tabulated {
+        name: String,
+        body1: String,
+        #[serde(default = "zero3")]
+        point1: Vec3,
+        body2: String,
+        #[serde(default = "zero3")]
+        point2: Vec3,
+        table: Vec<(Value, Value)>,
+        #[serde(default)]
+        d: Value,
+        #[serde(default)]
+        x0: Value,
+    },
     Applied {
         name: String,
         body: String,
@@ -441,7 +516,11 @@ impl RawForce {
         match self {
             RawForce::Spring { name, .. }
             | RawForce::Linear6 { name, .. }
-            | RawForce::Applied { name, .. } => name,
+            | RawForce::Applied { name, .. }
+            | RawForce::PointPlane { name, .. }
+            | RawForce::Coulomb { name, .. }
+            | RawForce::LoadFriction { name, .. }
+            | RawForce::Tabulated { name, .. } => name,
         }
     }
 }

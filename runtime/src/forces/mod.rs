@@ -7,11 +7,15 @@
 
 mod applied;
 mod bipolar;
+pub mod contact;
 mod linear6;
+pub mod nonlinear;
 
 pub use applied::AppliedForce;
 pub use bipolar::LinearBipolar;
+pub use contact::{PointPlane, contact_stiffness_damping};
 pub use linear6::Linear6;
+pub use nonlinear::{CoulombFriction, LoadFriction, Tabulated};
 
 use crate::equations::BodyKinematics;
 use crate::system::SimError;
@@ -269,6 +273,10 @@ pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
                 ForceKind::Bipolar { .. } => Box::new(LinearBipolar::new(name, &f.kind)),
                 ForceKind::Linear6 { .. } => Box::new(Linear6::new(name, &f.kind)),
                 ForceKind::Applied { .. } => Box::new(AppliedForce::new(name, &f.kind)),
+                ForceKind::PointPlane { .. } => Box::new(PointPlane::new(name, &f.kind)),
+                ForceKind::Coulomb { .. } => Box::new(CoulombFriction::new(name, &f.kind)),
+                ForceKind::LoadFriction { .. } => Box::new(LoadFriction::new(name, &f.kind)),
+                ForceKind::Tabulated { .. } => Box::new(Tabulated::new(name, &f.kind)),
             }
         })
         .collect()

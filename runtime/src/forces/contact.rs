@@ -1,0 +1,434 @@
+//! Point–plane contact with Coulomb friction (seed paper Sect. 3.3).
+//!
+//! Points fixed to one body touch a plane fixed to another body (or the
+//! ground). For a point P, the plane through O with outward unit normal n
+//! (both moving with the plane's body), the penetration is δ = −n·(P − O) and
+//! its rate δ̇ = −n·v_r, v_r the velocity of P relative to the plane's point
+//! under P. While δ > 0:
+//!
+//! * normal force N = max(0, c δ + d δ̇) along n: viscoelastic, no adhesion;
+//! * tangential force, Coulomb friction:
+//!   - sticking: P is tied to an anchor point A fixed in the plane by a
+//!     spring–damper, F_t = −(c_t s_t + d_t v_t) with s_t, v_t the tangential
+//!     parts of P − A and v_r, as long as |F_t| ≤ μ0 N;
+//!   - sliding: F_t = −μ N v_t/|v_t| (the direction regularized below
+//!     [`V_REG`]).
+//!
+//! The mode and anchor of each point change only in
+//! [`ForceElement::accept_step`] (never during Newton iterations or rejected
+//! steps), as for the bipolar friction elements ([`super::nonlinear`]): a
+//! sticking point whose trial force exceeds μ0 N is held at the limit μ0 N for
+//! the rest of the step and slides from the next one; a sliding point whose
+//! tangential velocity has reversed or fallen below [`V_STICK`] at the end of a
+//! step sticks again, with the anchor placed so that the sticking force equals
+//! the sliding force it replaces. A point that comes into contact starts
+//! sliding (sticking at once if its tangential speed is below `V_STICK`).
+
+use super::nonlinear::{V_REG, V_STICK};
+use super::{
+    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
+    eval_vector,
+};
+use crate::system::SimError;
+use nalgebra::{Matrix3, Vector3};
+use railmbs_models::{BodyRef, Expr, ForceKind};
+
+/// Normal stiffness c (N/m) and damping d (N s/m) that make a mass m (kg)
+/// resting on a linear contact vibrate at `frequency` (Hz) with the damping
+/// ratio ζ: c = 4π² f² m, d = 2ζ √(m c).
+///
+/// # Errors
+/// When f or m is not positive and finite, or ζ is negative or not finite.
+pub fn contact_stiffness_damping(
+    frequency: f64,
+    damping_ratio: f64,
+    mass: f64,
+) -> Result<(f64, f64), SimError> {
+    if !(frequency > 0.0 && frequency.is_finite()) {
+        return Err(SimError::Other(format!(
+            "contact frequency must be positive and finite, got {frequency} Hz"
+        )));
+    }
+    if !(mass > 0.0 && mass.is_finite()) {
+        return Err(SimError::Other(format!(
+            "contact mass must be positive and finite, got {mass} kg"
+        )));
+    }
+    if !(damping_ratio >= 0.0 && damping_ratio.is_finite()) {
+        return Err(SimError::Other(format!(
+            "contact damping ratio must be non-negative and finite, got {damping_ratio}"
+        )));
+    }
+    let c = 4.0 * std::f64::consts::PI.powi(2) * frequency * frequency * mass;
+    Ok((c, 2.0 * damping_ratio * (mass * c).sqrt()))
+}
+
+/// State of one contact point (changes only in `accept_step`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactMode {
+    /// Not in contact at the last accepted step.
+    Free,
+    /// Sticking to the anchor, given in the plane body's frame (m).
+    Stick { anchor: Vector3<f64> },
+    /// Sliding; `dir` the unit tangential velocity (SC0) at the last accepted step.
+    Slide { dir: Vector3<f64> },
+}
+
+/// Point–plane contact of any number of points; see the module docs.
+#[derive(Debug, Clone)]
+pub struct PointPlane {
+    name: String,
+    points: Vec<Attachment>,
+    plane_body: Option<usize>,
+    origin_expr: [Expr; 3],
+    normal_expr: [Expr; 3],
+    coeff_expr: [Expr; 6],
+    /// Plane point and unit normal in the plane body's frame.
+    origin: Vector3<f64>,
+    normal: Vector3<f64>,
+    /// N/m, N s/m (normal); N/m, N s/m (tangential anchor).
+    pub c: f64,
+    pub d: f64,
+    pub ct: f64,
+    pub dt: f64,
+    /// Static and sliding friction coefficients.
+    pub mu_static: f64,
+    pub mu: f64,
+    /// One per point.
+    pub modes: Vec<ContactMode>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Tangential {
+    Stick,
+    /// Trial sticking force beyond μ0 N, held at the limit: unit direction.
+    Saturated(Vector3<f64>),
+    /// Sliding: regularized unit velocity direction, |v_t|.
+    Slide(Vector3<f64>, f64),
+}
+
+/// Everything about one point in contact at a state.
+struct PointEval {
+    p: Vector3<f64>,
+    n: Vector3<f64>,
+    /// Penetration, m.
+    delta: f64,
+    /// N.
+    normal_force: f64,
+    /// Tangential force on the point's body, N (SC0).
+    ft: Vector3<f64>,
+    /// Trial sticking force (Stick mode), N.
+    trial: Vector3<f64>,
+    /// Tangential relative velocity, m/s.
+    vt: Vector3<f64>,
+    branch: Tangential,
+}
+
+impl PointPlane {
+    /// From a model's `ForceKind::PointPlane`.
+    pub fn new(name: String, kind: &ForceKind) -> Self {
+        let ForceKind::PointPlane {
+            body,
+            points,
+            plane_body,
+            origin,
+            normal,
+            stiffness,
+            damping,
+            tangential_stiffness,
+            tangential_damping,
+            mu_static,
+            mu,
+        } = kind
+        else {
+            unreachable!("PointPlane::new takes a PointPlane element")
+        };
+        Self {
+            name,
+            points: points.iter().map(|p| Attachment::new(*body, p)).collect(),
+            plane_body: match plane_body {
+                BodyRef::Ground => None,
+                BodyRef::Body(i) => Some(*i),
+            },
+            origin_expr: origin.clone(),
+            normal_expr: normal.clone(),
+            coeff_expr: [
+                stiffness.clone(),
+                damping.clone(),
+                tangential_stiffness.clone(),
+                tangential_damping.clone(),
+                mu_static.clone(),
+                mu.clone(),
+            ],
+            origin: Vector3::zeros(),
+            normal: Vector3::z(),
+            c: 0.0,
+            d: 0.0,
+            ct: 0.0,
+            dt: 0.0,
+            mu_static: 0.0,
+            mu: 0.0,
+            modes: vec![ContactMode::Free; points.len()],
+        }
+    }
+
+    /// Plane point, normal, rotation and kinematics helpers in SC0.
+    fn plane(&self, ctx: &ForceContext) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
+        match self.plane_body {
+            Some(b) => {
+                let k = &ctx.bodies[b];
+                (
+                    k.point_position(&self.origin),
+                    k.rotation * self.normal,
+                    k.rotation,
+                )
+            }
+            None => (self.origin, self.normal, Matrix3::identity()),
+        }
+    }
+
+    fn plane_velocity(&self, ctx: &ForceContext, p: &Vector3<f64>) -> Vector3<f64> {
+        match self.plane_body {
+            Some(b) => {
+                let k = &ctx.bodies[b];
+                k.velocity + k.angular_velocity.cross(&(p - k.position))
+            }
+            None => Vector3::zeros(),
+        }
+    }
+
+    /// Anchor (plane frame) to SC0 and back.
+    fn to_world(&self, ctx: &ForceContext, a: &Vector3<f64>) -> Vector3<f64> {
+        match self.plane_body {
+            Some(b) => ctx.bodies[b].point_position(a),
+            None => *a,
+        }
+    }
+
+    fn to_plane(&self, ctx: &ForceContext, p: &Vector3<f64>) -> Vector3<f64> {
+        match self.plane_body {
+            Some(b) => ctx.bodies[b].rotation.transpose() * (p - ctx.bodies[b].position),
+            None => *p,
+        }
+    }
+
+    /// The contact of point k, or None when it does not penetrate.
+    fn evaluate(&self, ctx: &ForceContext, k: usize) -> Option<PointEval> {
+        let (o, n, _) = self.plane(ctx);
+        let att = &self.points[k];
+        let p = att.position(ctx);
+        let delta = -n.dot(&(p - o));
+        if delta <= 0.0 {
+            return None;
+        }
+        let vr = att.velocity(ctx) - self.plane_velocity(ctx, &p);
+        let delta_rate = -n.dot(&vr);
+        let normal_force = (self.c * delta + self.d * delta_rate).max(0.0);
+        let vt = vr - n * n.dot(&vr);
+        let limit0 = self.mu_static * normal_force;
+        let mut trial = Vector3::zeros();
+        let (ft, branch) = match self.modes[k] {
+            ContactMode::Stick { anchor } => {
+                let s = p - self.to_world(ctx, &anchor);
+                let st = s - n * n.dot(&s);
+                trial = -(self.ct * st + self.dt * vt);
+                let m = trial.norm();
+                if m <= limit0 {
+                    (trial, Tangential::Stick)
+                } else {
+                    let u = trial / m;
+                    (limit0 * u, Tangential::Saturated(u))
+                }
+            }
+            ContactMode::Slide { .. } | ContactMode::Free => {
+                let speed = vt.norm();
+                let w = vt / speed.max(V_REG);
+                (-self.mu * normal_force * w, Tangential::Slide(w, speed))
+            }
+        };
+        Some(PointEval {
+            p,
+            n,
+            delta,
+            normal_force,
+            ft,
+            trial,
+            vt,
+            branch,
+        })
+    }
+
+    /// Local Jacobians (∂f/∂d, ∂f/∂ḋ) of the force f on the point's body with
+    /// respect to the point's position and velocity relative to the plane.
+    fn local_jacobian(&self, e: &PointEval) -> (Matrix3<f64>, Matrix3<f64>) {
+        let n = e.n;
+        let nn = n * n.transpose();
+        let t = Matrix3::identity() - nn;
+        let loaded = e.normal_force > 0.0;
+        // ∂N/∂d = −c nᵀ, ∂N/∂ḋ = −d nᵀ while N > 0.
+        let (cn, dn) = if loaded { (self.c, self.d) } else { (0.0, 0.0) };
+        let mut kq = -cn * nn;
+        let mut kv = -dn * nn;
+        match e.branch {
+            Tangential::Stick => {
+                kq -= self.ct * t;
+                kv -= self.dt * t;
+            }
+            Tangential::Saturated(u) => {
+                let r = self.mu_static * e.normal_force / e.trial.norm();
+                let pu = Matrix3::identity() - u * u.transpose();
+                kq -= r * self.ct * pu * t + self.mu_static * cn * u * n.transpose();
+                kv -= r * self.dt * pu * t + self.mu_static * dn * u * n.transpose();
+            }
+            Tangential::Slide(w, speed) => {
+                kq += self.mu * cn * w * n.transpose();
+                kv += self.mu * dn * w * n.transpose();
+                let dw = if speed > V_REG {
+                    (Matrix3::identity() - w * w.transpose()) * t / speed
+                } else {
+                    t / V_REG
+                };
+                kv -= self.mu * e.normal_force * dw;
+            }
+        }
+        (kq, kv)
+    }
+
+    fn body(&self) -> Option<usize> {
+        self.points.first().and_then(|a| a.body)
+    }
+}
+
+impl ForceElement for PointPlane {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
+        for p in &mut self.points {
+            p.set_parameters(params, &self.name)?;
+        }
+        self.origin = eval_vector(&self.origin_expr, params, 0.0, &self.name)?;
+        let n = eval_vector(&self.normal_expr, params, 0.0, &self.name)?;
+        if n.norm() == 0.0 {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": the plane normal is zero",
+                self.name
+            )));
+        }
+        self.normal = n.normalize();
+        let names = ["c", "d", "ct", "dt", "mu0", "mu"];
+        let mut v = [0.0; 6];
+        for (k, e) in self.coeff_expr.iter().enumerate() {
+            v[k] = eval_scalar(e, params, &self.name, names[k])?;
+        }
+        [self.c, self.d, self.ct, self.dt, self.mu_static, self.mu] = v;
+        if !(self.c > 0.0 && self.ct > 0.0 && self.d >= 0.0 && self.dt >= 0.0) {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs c > 0, ct > 0, d ≥ 0, dt ≥ 0, got {}, {}, {}, {}",
+                self.name, self.c, self.ct, self.d, self.dt
+            )));
+        }
+        if !(0.0 <= self.mu && self.mu <= self.mu_static) {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs 0 ≤ mu ≤ mu0, got mu = {}, mu0 = {}",
+                self.name, self.mu, self.mu_static
+            )));
+        }
+        Ok(())
+    }
+
+    fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
+        let body = self.body();
+        for k in 0..self.points.len() {
+            if let Some(e) = self.evaluate(ctx, k) {
+                let f = e.normal_force * e.n + e.ft;
+                add_force(wrenches, ctx, body, &e.p, &f);
+                add_force(wrenches, ctx, self.plane_body, &e.p, &(-f));
+            }
+        }
+        Ok(())
+    }
+
+    fn output_names(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        for k in 0..self.points.len() {
+            for q in [
+                "N[N]",
+                "Ftx[N]",
+                "Fty[N]",
+                "Ftz[N]",
+                "penetration[m]",
+                "mode[-]",
+            ] {
+                v.push(format!("{k}.{q}"));
+            }
+        }
+        v
+    }
+
+    /// Per point: N, the tangential force (SC0), the penetration and the mode
+    /// (0 free, 1 sticking, 2 sliding).
+    fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        for k in 0..self.points.len() {
+            let mode = match self.modes[k] {
+                ContactMode::Free => 0.0,
+                ContactMode::Stick { .. } => 1.0,
+                ContactMode::Slide { .. } => 2.0,
+            };
+            match self.evaluate(ctx, k) {
+                Some(e) => out.extend([e.normal_force, e.ft.x, e.ft.y, e.ft.z, e.delta, mode]),
+                None => out.extend([0.0, 0.0, 0.0, 0.0, 0.0, mode]),
+            }
+        }
+    }
+
+    fn accept_step(&mut self, ctx: &ForceContext) {
+        for k in 0..self.points.len() {
+            let Some(e) = self.evaluate(ctx, k) else {
+                self.modes[k] = ContactMode::Free;
+                continue;
+            };
+            let speed = e.vt.norm();
+            // Anchor such that −c_t s_t equals the current tangential force.
+            let stick_here = |this: &Self| ContactMode::Stick {
+                anchor: this.to_plane(ctx, &(e.p + e.ft / this.ct)),
+            };
+            self.modes[k] = match (self.modes[k], e.branch) {
+                (ContactMode::Stick { .. }, Tangential::Saturated(_)) => ContactMode::Slide {
+                    dir: if speed > 0.0 {
+                        e.vt / speed
+                    } else {
+                        Vector3::zeros()
+                    },
+                },
+                (ContactMode::Stick { anchor }, _) => ContactMode::Stick { anchor },
+                (ContactMode::Slide { dir }, _) => {
+                    if speed < V_STICK || e.vt.dot(&dir) <= 0.0 {
+                        stick_here(self)
+                    } else {
+                        ContactMode::Slide { dir: e.vt / speed }
+                    }
+                }
+                (ContactMode::Free, _) => {
+                    if speed < V_STICK {
+                        stick_here(self)
+                    } else {
+                        ContactMode::Slide { dir: e.vt / speed }
+                    }
+                }
+            };
+        }
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let body = self.body();
+        for k in 0..self.points.len() {
+            if let Some(e) = self.evaluate(ctx, k) {
+                let (kq, kv) = self.local_jacobian(&e);
+                jac.add_point_pair(self.plane_body, &e.p, body, &e.p, &kq, &kv);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,652 @@
+//! Nonlinear bipolar elements (seed paper Sect. 3.1): Coulomb friction with
+//! sticking and sliding, load-dependent friction (Fig. 3) and tabulated
+//! force–deflection characteristics (bump stops).
+//!
+//! # State and mode switches
+//!
+//! The friction elements keep a state (mode, stored f0/x0, the deformation of
+//! the inner spring) that changes only in [`ForceElement::accept_step`], never
+//! during Newton iterations or in rejected steps. Within a step the force is a
+//! continuous function of (q, q̇) given that state:
+//!
+//! * sticking: the elastic law; when its force would exceed the static limit
+//!   it is held at the limit (saturated) for the rest of the step, and the
+//!   element slides from the next step on;
+//! * sliding: the sliding force against the relative velocity, with the sign
+//!   function regularized below [`V_REG`]; when the velocity has reversed or
+//!   dropped below [`V_STICK`] at the end of an accepted step, the element
+//!   sticks again with f0 and x0 stored so that the force is continuous.
+//!
+//! A mode switch is therefore delayed by at most one step and never smeared
+//! over several: the step-size control sees the kink of the saturated law
+//! and shortens the steps around it.
+
+use super::{
+    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
+};
+use crate::system::SimError;
+use nalgebra::{Matrix3, Vector3};
+use railmbs_models::{BodyRef, Expr, ForceKind};
+
+/// Velocity below which the sign of the sliding velocity is regularized
+/// linearly, m/s.
+pub const V_REG: f64 = 1e-5;
+/// Sliding speed below which an element sticks again at the end of a step, m/s.
+pub const V_STICK: f64 = 1e-4;
+
+/// Regularized sign: v/|v| for |v| ≥ V_REG, v/V_REG below; and its derivative.
+pub(crate) fn reg_sign(v: f64) -> (f64, f64) {
+    if v.abs() >= V_REG {
+        (v.signum(), 0.0)
+    } else {
+        (v / V_REG, 1.0 / V_REG)
+    }
+}
+
+/// Two attachment points and the kinematics of their distance.
+#[derive(Debug, Clone)]
+pub(crate) struct TwoPoint {
+    ends: [Attachment; 2],
+}
+
+/// Distance x (m), its rate (m/s), unit vector from end 1 to end 2 (None at
+/// zero length), the end positions (SC0).
+pub(crate) struct PairState {
+    pub length: f64,
+    pub rate: f64,
+    pub direction: Option<Vector3<f64>>,
+    pub p1: Vector3<f64>,
+    pub p2: Vector3<f64>,
+    pub relative_velocity: Vector3<f64>,
+}
+
+impl TwoPoint {
+    pub fn new(b1: BodyRef, p1: &[Expr; 3], b2: BodyRef, p2: &[Expr; 3]) -> Self {
+        Self {
+            ends: [Attachment::new(b1, p1), Attachment::new(b2, p2)],
+        }
+    }
+
+    pub fn set_parameters(&mut self, params: &[f64], owner: &str) -> Result<(), SimError> {
+        for e in &mut self.ends {
+            e.set_parameters(params, owner)?;
+        }
+        Ok(())
+    }
+
+    pub fn state(&self, ctx: &ForceContext) -> PairState {
+        let p1 = self.ends[0].position(ctx);
+        let p2 = self.ends[1].position(ctx);
+        let dv = self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx);
+        let d = p2 - p1;
+        let length = d.norm();
+        if length <= f64::MIN_POSITIVE {
+            return PairState {
+                length: 0.0,
+                rate: 0.0,
+                direction: None,
+                p1,
+                p2,
+                relative_velocity: dv,
+            };
+        }
+        let e = d / length;
+        PairState {
+            length,
+            rate: dv.dot(&e),
+            direction: Some(e),
+            p1,
+            p2,
+            relative_velocity: dv,
+        }
+    }
+
+    /// Applies the tension `f` (N, positive pulls the ends together).
+    pub fn apply(&self, ctx: &ForceContext, s: &PairState, f: f64, wrenches: &mut [Wrench]) {
+        let Some(e) = s.direction else { return };
+        let fv = f * e;
+        add_force(wrenches, ctx, self.ends[0].body, &s.p1, &fv);
+        add_force(wrenches, ctx, self.ends[1].body, &s.p2, &(-fv));
+    }
+
+    /// Adds the Jacobian of a tension F(x, ẋ) with ∂F/∂x = `dfdx`, ∂F/∂ẋ =
+    /// `dfdv`: for f₂ = −F e, ∂f₂/∂d = −[e (F_x e + F_v (E − e eᵀ) ḋ/x)ᵀ +
+    /// (F/x)(E − e eᵀ)] and ∂f₂/∂ḋ = −F_v e eᵀ.
+    pub fn add_jacobian(
+        &self,
+        s: &PairState,
+        f: f64,
+        dfdx: f64,
+        dfdv: f64,
+        jac: &mut ForceJacobian,
+    ) {
+        let Some(e) = s.direction else { return };
+        let (kq, kv) = bipolar_jacobian(&e, s.length, &s.relative_velocity, f, dfdx, dfdv);
+        jac.add_point_pair(self.ends[0].body, &s.p1, self.ends[1].body, &s.p2, &kq, &kv);
+    }
+}
+
+/// Local Jacobians (∂f₂/∂d, ∂f₂/∂ḋ) of a bipolar tension F(x, ẋ), see
+/// [`TwoPoint::add_jacobian`].
+pub(crate) fn bipolar_jacobian(
+    e: &Vector3<f64>,
+    x: f64,
+    dd: &Vector3<f64>,
+    f: f64,
+    dfdx: f64,
+    dfdv: f64,
+) -> (Matrix3<f64>, Matrix3<f64>) {
+    let transverse = Matrix3::identity() - e * e.transpose();
+    let g = dfdx * e + dfdv * (transverse * dd) / x;
+    let kq = -(e * g.transpose() + (f / x) * transverse);
+    let kv = -dfdv * e * e.transpose();
+    (kq, kv)
+}
+
+// ---------------------------------------------------------------------------
+// Coulomb friction
+// ---------------------------------------------------------------------------
+
+/// Mode of a friction element (changes only in `accept_step`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FrictionMode {
+    /// No state yet (before the first accepted step): behaves as sliding.
+    Initial,
+    /// Sticking with the stored force f0 (N) at the stored length x0 (m).
+    Stick { f0: f64, x0: f64 },
+    /// Sliding; `dir` is the sign of ẋ when the mode was entered or last
+    /// confirmed.
+    Slide { dir: f64 },
+}
+
+/// Bipolar Coulomb friction: sticking F = f0 + c (x − x0) + d ẋ (f0, x0
+/// stored when sticking begins) while |F| ≤ F0 (the static limit); sliding
+/// F = F_s sign(ẋ) (F_s ≤ F0). Positive F pulls the points together (it
+/// resists extension). See the module docs for the mode switches.
+#[derive(Debug, Clone)]
+pub struct CoulombFriction {
+    name: String,
+    pair: TwoPoint,
+    exprs: [Expr; 4],
+    /// N/m.
+    pub stiffness: f64,
+    /// N s/m.
+    pub damping: f64,
+    /// Static limit F0, N.
+    pub static_limit: f64,
+    /// Sliding force F_s, N.
+    pub sliding_force: f64,
+    /// Current mode.
+    pub mode: FrictionMode,
+}
+
+/// How a friction force was obtained (for the Jacobian and the next mode).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Branch {
+    Stick,
+    /// Stick law beyond the limit, held at the limit (sign of the trial force).
+    Saturated(f64),
+    Slide,
+}
+
+impl CoulombFriction {
+    /// From a model's `ForceKind::Coulomb`.
+    pub fn new(name: String, kind: &ForceKind) -> Self {
+        let ForceKind::Coulomb {
+            body1,
+            point1,
+            body2,
+            point2,
+            stiffness,
+            damping,
+            static_limit,
+            sliding_force,
+        } = kind
+        else {
+            unreachable!("CoulombFriction::new takes a Coulomb element")
+        };
+        Self {
+            name,
+            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            exprs: [
+                stiffness.clone(),
+                damping.clone(),
+                static_limit.clone(),
+                sliding_force.clone(),
+            ],
+            stiffness: 0.0,
+            damping: 0.0,
+            static_limit: 0.0,
+            sliding_force: 0.0,
+            mode: FrictionMode::Initial,
+        }
+    }
+
+    /// Tension (N), ∂F/∂x, ∂F/∂ẋ and the branch at length x, rate v.
+    fn law(&self, x: f64, v: f64) -> (f64, f64, f64, Branch) {
+        match self.mode {
+            FrictionMode::Stick { f0, x0 } => {
+                let f = f0 + self.stiffness * (x - x0) + self.damping * v;
+                if f.abs() <= self.static_limit {
+                    (f, self.stiffness, self.damping, Branch::Stick)
+                } else {
+                    let s = f.signum();
+                    (s * self.static_limit, 0.0, 0.0, Branch::Saturated(s))
+                }
+            }
+            FrictionMode::Slide { .. } | FrictionMode::Initial => {
+                let (s, ds) = reg_sign(v);
+                (
+                    self.sliding_force * s,
+                    0.0,
+                    self.sliding_force * ds,
+                    Branch::Slide,
+                )
+            }
+        }
+    }
+}
+
+impl ForceElement for CoulombFriction {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
+        self.pair.set_parameters(params, &self.name)?;
+        let [c, d, f0, fs] = &self.exprs;
+        self.stiffness = eval_scalar(c, params, &self.name, "stiffness c")?;
+        self.damping = eval_scalar(d, params, &self.name, "damping d")?;
+        self.static_limit = eval_scalar(f0, params, &self.name, "static limit")?;
+        self.sliding_force = eval_scalar(fs, params, &self.name, "sliding force")?;
+        if self.stiffness <= 0.0 || self.damping < 0.0 {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs c > 0 and d ≥ 0, got c = {}, d = {}",
+                self.name, self.stiffness, self.damping
+            )));
+        }
+        if !(0.0 <= self.sliding_force && self.sliding_force <= self.static_limit) {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs 0 ≤ sliding force ≤ static limit, got {} and {}",
+                self.name, self.sliding_force, self.static_limit
+            )));
+        }
+        Ok(())
+    }
+
+    fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, ..) = self.law(s.length, s.rate);
+        self.pair.apply(ctx, &s, f, wrenches);
+        Ok(())
+    }
+
+    fn output_names(&self) -> Vec<String> {
+        ["F[N]", "x[m]", "v[m/s]", "sliding[-]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        let s = self.pair.state(ctx);
+        let (f, ..) = self.law(s.length, s.rate);
+        let f = if s.direction.is_some() { f } else { 0.0 };
+        let sliding = matches!(self.mode, FrictionMode::Slide { .. }) as u8 as f64;
+        out.extend([f, s.length, s.rate, sliding]);
+    }
+
+    fn accept_step(&mut self, ctx: &ForceContext) {
+        let s = self.pair.state(ctx);
+        let (f, _, _, branch) = self.law(s.length, s.rate);
+        self.mode = match (self.mode, branch) {
+            (FrictionMode::Stick { .. }, Branch::Saturated(sign)) => {
+                FrictionMode::Slide { dir: sign }
+            }
+            (FrictionMode::Stick { .. }, _) => self.mode,
+            (FrictionMode::Slide { dir }, _) => {
+                if s.rate * dir <= 0.0 || s.rate.abs() < V_STICK {
+                    FrictionMode::Stick {
+                        f0: f,
+                        x0: s.length,
+                    }
+                } else {
+                    FrictionMode::Slide { dir }
+                }
+            }
+            (FrictionMode::Initial, _) => {
+                if s.rate.abs() < V_STICK {
+                    FrictionMode::Stick {
+                        f0: f,
+                        x0: s.length,
+                    }
+                } else {
+                    FrictionMode::Slide {
+                        dir: s.rate.signum(),
+                    }
+                }
+            }
+        };
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, fx, fv, _) = self.law(s.length, s.rate);
+        self.pair.add_jacobian(&s, f, fx, fv, jac);
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Load-dependent friction
+// ---------------------------------------------------------------------------
+
+/// Load-dependent friction (paper Sect. 3.1, Fig. 3): spring c1 in series
+/// with a block of spring c2 in parallel with friction μ·|c2·x2| (x2 the
+/// block's deformation). With x = distance − x0 and the force
+/// F = c1 (x − x2):
+///
+/// * sticking (x2 stored): F = c1 (x − x2) while |F − c2 x2| ≤ μ0 c2 |x2|;
+/// * sliding in direction s (sign of ẋ2): F = c2 x2 (1 + s μ sign x2), so
+///   x2 = c1 x / (c1 + a) and F = c1 a x / (c1 + a) with a = c2 (1 + s μ sign x),
+///   stiffer when loading than when unloading: a hysteresis loop whose area
+///   does not depend on the rate.
+///
+/// Beyond the static limit within a step the law follows the sliding branch
+/// with μ0 (continuous with the sticking line); see the module docs.
+#[derive(Debug, Clone)]
+pub struct LoadFriction {
+    name: String,
+    pair: TwoPoint,
+    exprs: [Expr; 5],
+    /// N/m.
+    pub c1: f64,
+    /// N/m.
+    pub c2: f64,
+    pub mu_static: f64,
+    pub mu: f64,
+    /// m.
+    pub free_length: f64,
+    /// Stored deformation of the c2 block, m.
+    pub x2: f64,
+    /// Current mode (`Stick` uses only the mode, not its f0/x0).
+    pub mode: FrictionMode,
+}
+
+impl LoadFriction {
+    /// From a model's `ForceKind::LoadFriction`.
+    pub fn new(name: String, kind: &ForceKind) -> Self {
+        let ForceKind::LoadFriction {
+            body1,
+            point1,
+            body2,
+            point2,
+            c1,
+            c2,
+            mu_static,
+            mu,
+            free_length,
+        } = kind
+        else {
+            unreachable!("LoadFriction::new takes a LoadFriction element")
+        };
+        Self {
+            name,
+            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            exprs: [
+                c1.clone(),
+                c2.clone(),
+                mu_static.clone(),
+                mu.clone(),
+                free_length.clone(),
+            ],
+            c1: 0.0,
+            c2: 0.0,
+            mu_static: 0.0,
+            mu: 0.0,
+            free_length: 0.0,
+            x2: 0.0,
+            // Unloaded block: no friction capacity, so the first motion slides.
+            mode: FrictionMode::Stick { f0: 0.0, x0: 0.0 },
+        }
+    }
+
+    /// Sliding branch in direction `s` with coefficient `mu`: (F, ∂F/∂x, x2).
+    fn sliding(&self, x: f64, s: f64, mu: f64) -> (f64, f64, f64) {
+        let sx = if x >= 0.0 { 1.0 } else { -1.0 };
+        let a = self.c2 * (1.0 + s * sx * mu);
+        let k = self.c1 * a / (self.c1 + a);
+        (k * x, k, self.c1 * x / (self.c1 + a))
+    }
+
+    /// (F, ∂F/∂x, x2, branch) at deflection x (m) and rate v.
+    fn law(&self, x: f64, v: f64) -> (f64, f64, f64, Branch) {
+        match self.mode {
+            FrictionMode::Slide { dir } => {
+                let (f, k, x2) = self.sliding(x, dir, self.mu);
+                (f, k, x2, Branch::Slide)
+            }
+            FrictionMode::Stick { .. } | FrictionMode::Initial => {
+                let f = self.c1 * (x - self.x2);
+                let excess = f - self.c2 * self.x2;
+                if excess.abs() <= self.mu_static * self.c2 * self.x2.abs() {
+                    (f, self.c1, self.x2, Branch::Stick)
+                } else {
+                    let s = if excess != 0.0 {
+                        excess.signum()
+                    } else {
+                        v.signum()
+                    };
+                    let (f, k, x2) = self.sliding(x, s, self.mu_static);
+                    (f, k, x2, Branch::Saturated(s))
+                }
+            }
+        }
+    }
+}
+
+impl ForceElement for LoadFriction {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
+        self.pair.set_parameters(params, &self.name)?;
+        let [c1, c2, m0, m, x0] = &self.exprs;
+        self.c1 = eval_scalar(c1, params, &self.name, "c1")?;
+        self.c2 = eval_scalar(c2, params, &self.name, "c2")?;
+        self.mu_static = eval_scalar(m0, params, &self.name, "mu0")?;
+        self.mu = eval_scalar(m, params, &self.name, "mu")?;
+        self.free_length = eval_scalar(x0, params, &self.name, "x0")?;
+        if self.c1 <= 0.0 || self.c2 <= 0.0 {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs c1 > 0 and c2 > 0, got {} and {}",
+                self.name, self.c1, self.c2
+            )));
+        }
+        if !(0.0 <= self.mu && self.mu <= self.mu_static && self.mu_static < 1.0) {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": needs 0 ≤ mu ≤ mu0 < 1, got mu = {}, mu0 = {}",
+                self.name, self.mu, self.mu_static
+            )));
+        }
+        Ok(())
+    }
+
+    fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, ..) = self.law(s.length - self.free_length, s.rate);
+        self.pair.apply(ctx, &s, f, wrenches);
+        Ok(())
+    }
+
+    fn output_names(&self) -> Vec<String> {
+        ["F[N]", "x[m]", "x2[m]", "sliding[-]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        let s = self.pair.state(ctx);
+        let x = s.length - self.free_length;
+        let (f, _, x2, _) = self.law(x, s.rate);
+        let f = if s.direction.is_some() { f } else { 0.0 };
+        let sliding = matches!(self.mode, FrictionMode::Slide { .. }) as u8 as f64;
+        out.extend([f, x, x2, sliding]);
+    }
+
+    fn accept_step(&mut self, ctx: &ForceContext) {
+        let s = self.pair.state(ctx);
+        let (_, _, x2, branch) = self.law(s.length - self.free_length, s.rate);
+        self.mode = match (self.mode, branch) {
+            (_, Branch::Saturated(sign)) => FrictionMode::Slide { dir: sign },
+            (FrictionMode::Slide { dir }, _) if s.rate * dir > 0.0 => FrictionMode::Slide { dir },
+            _ => FrictionMode::Stick { f0: 0.0, x0: 0.0 },
+        };
+        self.x2 = x2;
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, k, ..) = self.law(s.length - self.free_length, s.rate);
+        self.pair.add_jacobian(&s, f, k, 0.0, jac);
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Tabulated characteristic
+// ---------------------------------------------------------------------------
+
+/// Tabulated force–deflection characteristic: F = f(x − x0) + d ẋ with f
+/// piecewise linear through the table rows, extended linearly beyond the
+/// first and last rows (a bump stop keeps its end stiffness). Positive F pulls
+/// the points together.
+#[derive(Debug, Clone)]
+pub struct Tabulated {
+    name: String,
+    pair: TwoPoint,
+    table_expr: Vec<(Expr, Expr)>,
+    damping_expr: Expr,
+    x0_expr: Expr,
+    /// Deflections, m (increasing).
+    pub deflections: Vec<f64>,
+    /// Forces, N.
+    pub forces: Vec<f64>,
+    /// N s/m.
+    pub damping: f64,
+    /// m.
+    pub free_length: f64,
+}
+
+impl Tabulated {
+    /// From a model's `ForceKind::Tabulated`.
+    pub fn new(name: String, kind: &ForceKind) -> Self {
+        let ForceKind::Tabulated {
+            body1,
+            point1,
+            body2,
+            point2,
+            table,
+            damping,
+            free_length,
+        } = kind
+        else {
+            unreachable!("Tabulated::new takes a Tabulated element")
+        };
+        Self {
+            name,
+            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            table_expr: table.clone(),
+            damping_expr: damping.clone(),
+            x0_expr: free_length.clone(),
+            deflections: Vec::new(),
+            forces: Vec::new(),
+            damping: 0.0,
+            free_length: 0.0,
+        }
+    }
+
+    /// Table value f(u) (N) and slope (N/m) at deflection u (m).
+    pub fn characteristic(&self, u: f64) -> (f64, f64) {
+        let xs = &self.deflections;
+        let fs = &self.forces;
+        // Segment k spans xs[k]..xs[k+1]; the end segments extend outwards.
+        let k = match xs.partition_point(|&x| x <= u) {
+            0 => 0,
+            i => (i - 1).min(xs.len() - 2),
+        };
+        let slope = (fs[k + 1] - fs[k]) / (xs[k + 1] - xs[k]);
+        (fs[k] + slope * (u - xs[k]), slope)
+    }
+}
+
+impl ForceElement for Tabulated {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
+        self.pair.set_parameters(params, &self.name)?;
+        self.deflections.clear();
+        self.forces.clear();
+        for (k, (x, f)) in self.table_expr.iter().enumerate() {
+            self.deflections.push(eval_scalar(
+                x,
+                params,
+                &self.name,
+                &format!("table[{k}].deflection"),
+            )?);
+            self.forces.push(eval_scalar(
+                f,
+                params,
+                &self.name,
+                &format!("table[{k}].force"),
+            )?);
+        }
+        if self.deflections.len() < 2 || self.deflections.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(SimError::Other(format!(
+                "force element \"{}\": the table needs at least 2 rows with increasing deflections, got {:?}",
+                self.name, self.deflections
+            )));
+        }
+        self.damping = eval_scalar(&self.damping_expr, params, &self.name, "damping d")?;
+        self.free_length = eval_scalar(&self.x0_expr, params, &self.name, "free length x0")?;
+        Ok(())
+    }
+
+    fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, _) = self.characteristic(s.length - self.free_length);
+        self.pair
+            .apply(ctx, &s, f + self.damping * s.rate, wrenches);
+        Ok(())
+    }
+
+    fn output_names(&self) -> Vec<String> {
+        ["F[N]", "x[m]", "v[m/s]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        let s = self.pair.state(ctx);
+        let (f, _) = self.characteristic(s.length - self.free_length);
+        let f = if s.direction.is_some() {
+            f + self.damping * s.rate
+        } else {
+            0.0
+        };
+        out.extend([f, s.length, s.rate]);
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let s = self.pair.state(ctx);
+        let (f, k) = self.characteristic(s.length - self.free_length);
+        self.pair
+            .add_jacobian(&s, f + self.damping * s.rate, k, self.damping, jac);
+        Ok(())
+    }
+}
