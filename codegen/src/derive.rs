@@ -184,6 +184,8 @@ pub struct Derived {
     pub constraint_jacobian_index: Vec<(usize, usize)>,
     pub dof: usize,
     pub bodies: usize,
+    /// Runtime inputs (each with value, rate, acceleration in `u`).
+    pub inputs: usize,
 }
 
 /// Converts a model expression into the context.
@@ -338,6 +340,15 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                     let xd = alg.ctx.diff(x, Symbol::t());
                     let xdd = alg.ctx.diff(xd, Symbol::t());
                     (x, xd, xdd)
+                }
+                // Runtime input k: value, rate, acceleration in u[3k..3k+3].
+                Motion::Input(k) => {
+                    let k = 3 * *k as u32;
+                    (
+                        alg.ctx.sym(Symbol::u(k)),
+                        alg.ctx.sym(Symbol::u(k + 1)),
+                        alg.ctx.sym(Symbol::u(k + 2)),
+                    )
                 }
             };
             let u = alg.column(&s.a, axis);
@@ -743,6 +754,7 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         constraint_jacobian: cjac.into_iter().map(|(_, e)| e).collect(),
         dof: n,
         bodies: nb,
+        inputs: 6 * model.track_frames.len(),
         ctx,
     }
 }

@@ -263,6 +263,7 @@ fn emit_unit(
     n_params: usize,
     n_bodies: usize,
     n_constraints: usize,
+    n_inputs: usize,
     max_instrs: usize,
     functions: &mut usize,
 ) -> TokenStream {
@@ -298,7 +299,7 @@ fn emit_unit(
             fused_skip.insert(si.max(ci));
         }
     }
-    let (nq, np) = (n, n_params);
+    let (nq, np, nu) = (n, n_params, 3 * n_inputs);
     for (ci, chunk) in split.chunks.iter().enumerate() {
         let fname = format_ident!("{}_{}", unit.name, ci);
         let local = |k: u32| {
@@ -356,6 +357,7 @@ fn emit_unit(
                 let q: &[f64; #nq] = q.try_into().expect("host buffer sized by the ABI");
                 let v: &[f64; #nq] = v.try_into().expect("host buffer sized by the ABI");
                 let p: &[f64; #np] = p.try_into().expect("host buffer sized by the ABI");
+                let u: &[f64; #nu] = u.try_into().expect("host buffer sized by the ABI");
                 let s: &mut [f64; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
                 #(#views)*
                 #(#loads)*
@@ -441,7 +443,7 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let mut functions = 0;
     let bodies: Vec<TokenStream> = units
         .iter()
-        .map(|u| emit_unit(u, n, np, nb, nc, max_instrs, &mut functions))
+        .map(|u| emit_unit(u, n, np, nb, nc, d.inputs, max_instrs, &mut functions))
         .collect();
     stats.functions = functions;
     let has_con = nc > 0;
@@ -458,6 +460,8 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let coords = c_string_list(&header.coordinate_names);
     let params = c_string_list(&header.parameter_names);
     let nfixed = header.fixed.len();
+    let ni = d.inputs;
+    let nu_len = 3 * ni;
     let fixed_idx: Vec<TokenStream> = header
         .fixed
         .iter()
@@ -551,7 +555,7 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
                 bodies: #nb as u32,
                 constraints: #nc as u32,
                 parameters: #np as u32,
-                inputs: 0,
+                inputs: #ni as u32,
                 model_hash: MODEL_HASH.as_ptr() as *const c_char,
                 model_name: MODEL_NAME.as_ptr() as *const c_char,
                 coordinate_names: COORDINATE_NAMES.as_ptr() as *const c_char,
@@ -586,6 +590,7 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
                 || ((parts & PART_CONSTRAINTS != 0) && #has_con && (ob.constraints.is_null() || ob.constraint_jacobian.is_null()))
                 || (#n > 0 && (i.q.is_null() || i.v.is_null()))
                 || (#np > 0 && i.p.is_null())
+                || (#nu_len > 0 && i.u.is_null())
             {
                 return 1;
             }
@@ -593,7 +598,7 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
             let q = sl(i.q, #n);
             let v = sl(i.v, #n);
             let p = sl(i.p, #np);
-            let u: &[f64] = &[];
+            let u = sl(i.u, #nu_len);
             let mut o = Out {
                 mass: sl_mut(if need_dyn { ob.mass } else { std::ptr::null_mut() }, #mass_len),
                 bias: sl_mut(if need_dyn { ob.bias } else { std::ptr::null_mut() }, #bias_len),

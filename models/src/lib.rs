@@ -144,13 +144,19 @@
 //! |---|---|---|
 //! | `Revolute(parent, at, axis, coord, init, vel, to_com)` | `Tx Ty Tz`(at), `R<axis>`(coord), `Tx Ty Tz`(to_com) | `coord`, default `<body>.r<axis>` |
 //! | `Prismatic(...)`, same fields | `Tx Ty Tz`(at), `T<axis>`(coord), `Tx Ty Tz`(to_com) | `coord`, default `<body>.t<axis>` |
-//! | `SixDof(parent, at, order, init, vel)` | `Tx Ty Tz`(at), `Tx Ty Tz` coordinates, rotations in `order` (default `"xyz"`) | `<body>.x .y .z .rx .ry .rz` |
+//! | `SixDof(parent, at, order, init, vel, track)` | `Tx Ty Tz`(at), `Tx Ty Tz` coordinates, rotations in `order` (default `"xyz"`) | `<body>.x .y .z .rx .ry .rz` |
 //! | `Rigid(parent, at, rotation)` | `Tx Ty Tz`(at), `Rx Ry Rz`(rotation) | none |
 //! | `Joint(parent, transforms: [...])` | as written: `Tx(value)` fixed or with `t`, `Tx((coord: "q", init: …, vel: …))` a coordinate | as given |
 //!
 //! `at` is the joint point in the parent frame and `to_com` the vector from the
 //! joint point to the child's centre of mass in the child frame (both default
 //! zero). SixDof `init` and `vel` are `(x, y, z, about x, about y, about z)`.
+//! `track: Some(offset)` (m, an expression) puts a track-following frame at arc
+//! offset `offset` from the vehicle's reference position in front of the six
+//! coordinates: the joint then starts with the frame's pose `x y z` (translations)
+//! and yaw, pitch, roll (`rz ry rx`), which are runtime inputs supplied by the
+//! track at every evaluation (`Model::track_frames`, `Motion::Input`). The parent
+//! must be `ground`.
 //! Coordinates are numbered in body order (parents first), then transform order.
 //!
 //! ### Validation

@@ -28,6 +28,7 @@ pub fn parse_model(text: &str, file: &Path) -> Result<Model, ModelErrors> {
         errors: Vec::new(),
         names: Vec::new(),
         defaults: None,
+        track_offsets: HashMap::new(),
     };
     let model = cx.resolve(raw);
     if cx.errors.is_empty() {
@@ -108,6 +109,9 @@ struct Cx<'a> {
     names: Vec<String>,
     /// Default parameter values, when they could all be evaluated.
     defaults: Option<Vec<f64>>,
+    /// Track-frame offsets by body name (bodies whose joint starts with a
+    /// track-following frame).
+    track_offsets: HashMap<String, Expr>,
 }
 
 fn axis_name(a: Axis) -> &'static str {
@@ -236,7 +240,26 @@ impl Cx<'_> {
         };
         let cut_joints = self.cut_joints(&raw, &lookup);
         let forces = self.forces(&raw, &lookup);
+        // Number the track-following frames in body order; their input
+        // transformations carry the component (0..6) until now.
+        let mut bodies = bodies;
+        let mut track_frames = Vec::new();
+        for (b, body) in bodies.iter_mut().enumerate() {
+            if let Some(offset) = self.track_offsets.get(&body.name) {
+                let frame = track_frames.len();
+                for el in &mut body.joint {
+                    if let Motion::Input(component) = &mut el.motion {
+                        *component += 6 * frame;
+                    }
+                }
+                track_frames.push(TrackFrame {
+                    body: b,
+                    offset: offset.clone(),
+                });
+            }
+        }
         Model {
+            track_frames,
             name: raw.name.clone(),
             source: Some(self.file.to_path_buf()),
             parameters,
@@ -712,12 +735,42 @@ impl Cx<'_> {
                 self.fixed3(w, jb, true, "to_com", to_com);
             }
             RawJoint::SixDof {
+                parent,
                 at,
                 order,
                 init,
                 vel,
-                ..
+                track,
             } => {
+                if let Some(offset) = track {
+                    if parent != "ground" {
+                        self.err(
+                            w,
+                            Some("track"),
+                            None,
+                            format!(
+                                "a track-following frame moves relative to SC0: the parent must be \"ground\", not \"{parent}\""
+                            ),
+                        );
+                    }
+                    let e = self.expr(w, "track offset", "track", offset, false);
+                    self.track_offsets.insert(jb.body_name.to_string(), e);
+                    // Pose of the frame: x, y, z, then yaw (z), pitch (y), roll (x).
+                    let kinds = [
+                        ElementaryKind::Translation(Axis::X),
+                        ElementaryKind::Translation(Axis::Y),
+                        ElementaryKind::Translation(Axis::Z),
+                        ElementaryKind::Rotation(Axis::Z),
+                        ElementaryKind::Rotation(Axis::Y),
+                        ElementaryKind::Rotation(Axis::X),
+                    ];
+                    for (component, kind) in kinds.into_iter().enumerate() {
+                        jb.joint.push(Elementary {
+                            kind,
+                            motion: Motion::Input(component),
+                        });
+                    }
+                }
                 self.fixed3(w, jb, true, "at", at);
                 let inits = [&init.0, &init.1, &init.2, &init.3, &init.4, &init.5];
                 let vels = [&vel.0, &vel.1, &vel.2, &vel.3, &vel.4, &vel.5];

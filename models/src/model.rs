@@ -46,6 +46,11 @@ pub enum Motion {
     Coordinate(usize),
     /// A function of time `t` (and parameters): rheonomic. Metres or radians.
     Time(Expr),
+    /// Runtime input `k` (rheonomic): the runtime supplies its value, first and
+    /// second time derivatives at every evaluation. Inputs are the pose
+    /// components of the track-following frames, [`Model::track_frames`]
+    /// `[k / 6]`, component `k % 6` in the order x, y, z (m), yaw, pitch, roll (rad).
+    Input(usize),
 }
 
 /// One elementary transformation `tx ty tz rx ry rz`.
@@ -299,6 +304,23 @@ pub struct Macro {
     pub assignments: Vec<(usize, Expr)>,
 }
 
+/// A track-following frame (DESIGN.md): a frame moving along the track with
+/// the vehicle, at arc position s(t) + `offset`. Its pose enters the equations as
+/// six runtime inputs (x, y, z in SC0, then yaw, pitch, roll applied in that
+/// order: Rz·Ry·Rx), so curves, transitions and cant add the right centrifugal and
+/// gyroscopic terms in both engines without special cases.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackFrame {
+    /// The body whose joint starts with this frame.
+    pub body: usize,
+    /// Arc-length offset from the vehicle's reference position, m (positive
+    /// ahead), expression over parameters.
+    pub offset: Expr,
+}
+
+/// Pose components of a track-following frame, in input order.
+pub const TRACK_FRAME_COMPONENTS: [&str; 6] = ["x", "y", "z", "yaw", "pitch", "roll"];
+
 /// A resolved, validated model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -315,4 +337,6 @@ pub struct Model {
     pub coordinates: Vec<Coordinate>,
     pub cut_joints: Vec<CutJoint>,
     pub forces: Vec<ForceElement>,
+    /// Track-following frames; each supplies six runtime inputs.
+    pub track_frames: Vec<TrackFrame>,
 }

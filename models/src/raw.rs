@@ -156,6 +156,11 @@ fn default_gravity() -> Vec3 {
     (Value::Num(0.0), Value::Num(0.0), Value::Num(-9.81))
 }
 
+/// An optional number or expression written plainly (no `Some(...)`).
+fn some_value<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Value>, D::Error> {
+    Value::deserialize(d).map(Some)
+}
+
 fn ground_name() -> String {
     "ground".into()
 }
@@ -252,6 +257,10 @@ pub(crate) enum RawJoint {
         init: Vec6,
         #[serde(default)]
         vel: Vec6,
+        /// Attach the body to a track-following frame at this arc offset (m):
+        /// the joint then starts with the frame's six input transformations.
+        #[serde(default)]
+        track: Option<Value>,
     },
     Rigid {
         parent: String,
@@ -443,11 +452,11 @@ pub(crate) enum RawForce {
         c: Value,
         #[serde(default)]
         d: Value,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "some_value")]
         ct: Option<Value>,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "some_value")]
         dt: Option<Value>,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "some_value")]
         mu0: Option<Value>,
         #[serde(default)]
         mu: Value,
@@ -464,7 +473,7 @@ pub(crate) enum RawForce {
         #[serde(default)]
         d: Value,
         limit: Value,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "some_value")]
         sliding: Option<Value>,
     },
     LoadFriction {
@@ -477,7 +486,7 @@ pub(crate) enum RawForce {
         point2: Vec3,
         c1: Value,
         c2: Value,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "some_value")]
         mu0: Option<Value>,
         mu: Value,
         #[serde(default)]

@@ -156,6 +156,25 @@ pub trait Equations {
     /// Sets the parameter values (in `Model::parameters` order). Must be called
     /// before the first evaluation; engines precompute what depends on them only.
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError>;
+    /// Number of runtime inputs (the six pose components of each
+    /// track-following frame, `Model::track_frames`).
+    fn input_count(&self) -> usize {
+        0
+    }
+    /// Sets the runtime inputs for the next evaluations: for input k,
+    /// `u[3k]` its value, `u[3k + 1]` its rate, `u[3k + 2]` its acceleration
+    /// (m, m/s, m/s² or rad, rad/s, rad/s²).
+    fn set_inputs(&mut self, u: &[f64]) -> Result<(), SimError> {
+        if u.is_empty() {
+            Ok(())
+        } else {
+            Err(SimError::Other(format!(
+                "the {} engine takes no runtime inputs, got {}",
+                self.engine_name(),
+                u.len()
+            )))
+        }
+    }
     /// Evaluates the requested parts at (t, q, q̇) into `out`.
     fn evaluate(
         &mut self,

@@ -7,6 +7,7 @@
 
 pub mod equations;
 pub mod forces;
+pub mod inputs;
 pub mod integrate;
 pub mod model_system;
 pub mod numeric;
@@ -15,6 +16,7 @@ pub mod simulate;
 pub mod system;
 
 pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
+pub use inputs::{DrivenEquations, InputProvider};
 pub use model_system::ModelSystem;
 pub use numeric::NumericEquations;
 pub use plugin::{Plugin, PluginEquations, PluginError};

@@ -51,6 +51,14 @@ impl ModelSystem {
                 model.bodies.len()
             )));
         }
+        if equations.input_count() > 0 {
+            return Err(SimError::Other(format!(
+                "model \"{}\" has {} track-following frame(s) whose pose must come from a track: \
+                 wrap the engine in DrivenEquations with an input provider",
+                model.name,
+                model.track_frames.len()
+            )));
+        }
         equations.set_parameters(&params)?;
         let mut forces = forces::build(model);
         for f in &mut forces {

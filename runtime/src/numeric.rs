@@ -47,6 +47,8 @@ enum Source {
     Coordinate(usize),
     /// A function of time: index into `NumericEquations::time_motions`.
     Time(usize),
+    /// Runtime input k (value, rate, acceleration in `NumericEquations::inputs[3k..]`).
+    Input(usize),
 }
 
 #[derive(Debug, Clone)]
@@ -83,6 +85,12 @@ enum Step {
         rotation: bool,
         axis: usize,
         motion: usize,
+    },
+    /// Rotation or translation driven by runtime input `input`.
+    Input {
+        rotation: bool,
+        axis: usize,
+        input: usize,
     },
 }
 
@@ -159,6 +167,8 @@ pub struct NumericEquations {
     cuts: Vec<CutData>,
     constraint_count: usize,
     time_motions: Vec<TimeMotion>,
+    /// Runtime inputs: value, rate, acceleration of each (m or rad, per s, per s²).
+    inputs: Vec<f64>,
     steps: Vec<Step>,
     params: Vec<f64>,
     parameters_set: bool,
@@ -209,6 +219,30 @@ fn rotate_columns(a: &mut Matrix3<f64>, axis: usize, s: f64) {
     let aj = a.column(j).into_owned();
     a.set_column(i, &(ai * c + aj * sn));
     a.set_column(j, &(aj * c - ai * sn));
+}
+
+/// A rheonomic rotation or translation along axis `axis` of the current frame
+/// with prescribed value, rate and acceleration.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn rheonomic(
+    s: &mut FrameState,
+    rotation: bool,
+    axis: usize,
+    val: f64,
+    rate: f64,
+    acc: f64,
+    with_acc: bool,
+) {
+    let u = s.a.column(axis).into_owned();
+    if rotation {
+        rotate(s, axis, &u, val, rate, acc, with_acc);
+    } else {
+        let d = u * val;
+        let v_rel = u * rate;
+        let a_rel = u * acc;
+        translate(s, &d, Some((&v_rel, &a_rel)), with_acc);
+    }
 }
 
 /// Translation of the frame by `d` (SC0) moving with relative velocity
@@ -353,6 +387,7 @@ impl NumericEquations {
                         });
                         Source::Time(time_motions.len() - 1)
                     }
+                    Motion::Input(k) => Source::Input(*k),
                 };
                 ops.push(Op {
                     rotation,
@@ -388,6 +423,7 @@ impl NumericEquations {
             cuts,
             constraint_count,
             time_motions,
+            inputs: vec![0.0; 18 * model.track_frames.len()],
             steps: Vec::new(),
             params: Vec::new(),
             parameters_set: false,
@@ -473,6 +509,11 @@ impl NumericEquations {
                         axis: op.axis,
                         motion: *k,
                     },
+                    Source::Input(k) => Step::Input {
+                        rotation: op.rotation,
+                        axis: op.axis,
+                        input: *k,
+                    },
                 };
                 steps.push(step);
             }
@@ -548,15 +589,15 @@ impl NumericEquations {
                         let val = m.value.eval(&self.params, t);
                         let rate = m.rate.eval(&self.params, t);
                         let acc = m.acceleration.eval(&self.params, t);
-                        let u = s.a.column(axis).into_owned();
-                        if rotation {
-                            rotate(s, axis, &u, val, rate, acc, with_acc);
-                        } else {
-                            let d = u * val;
-                            let v_rel = u * rate;
-                            let a_rel = u * acc;
-                            translate(s, &d, Some((&v_rel, &a_rel)), with_acc);
-                        }
+                        rheonomic(s, rotation, axis, val, rate, acc, with_acc);
+                    }
+                    Step::Input {
+                        rotation,
+                        axis,
+                        input,
+                    } => {
+                        let u = &self.inputs[3 * input..3 * input + 3];
+                        rheonomic(s, rotation, axis, u[0], u[1], u[2], with_acc);
                     }
                 }
             }
@@ -920,6 +961,20 @@ impl Equations for NumericEquations {
     }
     fn parameter_count(&self) -> usize {
         self.parameter_count
+    }
+    fn input_count(&self) -> usize {
+        self.inputs.len() / 3
+    }
+    fn set_inputs(&mut self, u: &[f64]) -> Result<(), SimError> {
+        if u.len() != self.inputs.len() {
+            return Err(SimError::Other(format!(
+                "the numeric engine takes {} input values (3 per input), got {}",
+                self.inputs.len(),
+                u.len()
+            )));
+        }
+        self.inputs.copy_from_slice(u);
+        Ok(())
     }
 
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {

@@ -140,6 +140,8 @@ pub struct Plugin {
     pub bodies: usize,
     pub constraints: usize,
     pub parameters: usize,
+    /// Runtime inputs (3 numbers each: value, rate, acceleration).
+    pub inputs: usize,
     pub model_name: String,
     pub model_hash: String,
     pub coordinate_names: Vec<String>,
@@ -203,6 +205,7 @@ impl Plugin {
             bodies: info.bodies as usize,
             constraints: info.constraints as usize,
             parameters: info.parameters as usize,
+            inputs: info.inputs as usize,
             model_name: c_str(info.model_name),
             model_hash: c_str(info.model_hash),
             coordinate_names: c_str_list(info.coordinate_names, info.dof as usize),
@@ -219,6 +222,7 @@ impl Plugin {
             || p.dof != model.coordinates.len()
             || p.bodies != model.bodies.len()
             || p.parameters != model.parameters.len()
+            || p.inputs != 6 * model.track_frames.len()
         {
             return Err(PluginError::ModelMismatch {
                 path: path.to_path_buf(),
@@ -244,17 +248,20 @@ pub struct PluginEquations {
     params: Vec<f64>,
     parameters_set: bool,
     kinematics: Vec<f64>,
+    inputs: Vec<f64>,
 }
 
 impl PluginEquations {
     /// Wraps a loaded plugin.
     pub fn new(plugin: Plugin) -> Self {
         let nb = plugin.bodies;
+        let ni = plugin.inputs;
         Self {
             params: vec![0.0; plugin.parameters],
             plugin,
             parameters_set: false,
             kinematics: vec![0.0; 18 * nb],
+            inputs: vec![0.0; 3 * ni],
         }
     }
 
@@ -279,6 +286,22 @@ impl Equations for PluginEquations {
     }
     fn parameter_count(&self) -> usize {
         self.plugin.parameters
+    }
+    fn input_count(&self) -> usize {
+        self.plugin.inputs
+    }
+
+    fn set_inputs(&mut self, u: &[f64]) -> Result<(), SimError> {
+        if u.len() != self.inputs.len() {
+            return Err(SimError::Other(format!(
+                "plugin {} takes {} input values (3 per input), got {}",
+                self.plugin.path.display(),
+                self.inputs.len(),
+                u.len()
+            )));
+        }
+        self.inputs.copy_from_slice(u);
+        Ok(())
     }
 
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
@@ -347,7 +370,11 @@ impl Equations for PluginEquations {
             q: q.as_ptr(),
             v: v.as_ptr(),
             p: self.params.as_ptr(),
-            u: std::ptr::null(),
+            u: if self.inputs.is_empty() {
+                std::ptr::null()
+            } else {
+                self.inputs.as_ptr()
+            },
         };
         let outputs = Outputs {
             mass: out.mass.as_mut_slice().as_mut_ptr(),
