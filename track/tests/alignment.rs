@@ -1,4 +1,5 @@
 //! Alignment, vertical profile and cant against analytic results.
+#![allow(clippy::needless_range_loop)] // index loops mirror the vector formulas
 
 use railmbs_track::{
     Alignment, Direction, Section, Track, TrackError, VerticalProfile, cant_angle,

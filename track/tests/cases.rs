@@ -1,4 +1,5 @@
 //! Track cases: the documented data are what the constructors build.
+#![allow(clippy::needless_range_loop)] // index loops mirror the vector formulas
 
 use railmbs_track::cases::*;
 use railmbs_track::{STANDARD_GRAVITY, balancing_speed, uncompensated_lateral_acceleration};

@@ -1,4 +1,5 @@
 //! Track-following frame against analytic results and finite differences.
+#![allow(clippy::needless_range_loop)] // index loops mirror the vector formulas
 
 use railmbs_track::{
     Alignment, ConstantSpeed, Direction, Section, SpeedLaw, SpeedTable, Track, TrackFrame,

@@ -1,4 +1,5 @@
 //! Irregularities: dips, sinusoids, widening, CSV, PSD generator.
+#![allow(clippy::needless_range_loop)] // index loops mirror the vector formulas
 
 use std::path::PathBuf;
 
