@@ -14,7 +14,7 @@
 use crate::error::{TrackError, check_param, finite, invalid};
 
 /// Direction of a curve as seen in the direction of increasing `s`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Direction {
     /// Curving to the left (κ > 0).
     Left,

@@ -77,7 +77,7 @@ impl RailDeviation {
 
 /// Which irregularity component a signal drives. Gauge and cross-level are
 /// split equally between the rails (±v/2), keeping the centre line in place.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Component {
     /// Both rails move laterally (alignment).
     Lateral,
@@ -90,7 +90,7 @@ pub enum Component {
 }
 
 /// Which rail(s) a dip affects.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Rail {
     /// The left rail.
     Left,
@@ -101,7 +101,7 @@ pub enum Rail {
 }
 
 /// Shape of a vertical dip over its length L, depth d, u = s − start ∈ [0, L].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum DipShape {
     /// Linear ("V"): z = −d (1 − |2u/L − 1|), straight ramps down to the depth
     /// at mid-length and back up (the Manchester benchmark's "linear dip").

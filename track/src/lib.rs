@@ -15,7 +15,8 @@
 //! - [`irregularity`]: dips, sinusoids, gauge widening, measured (CSV) and
 //!   their sum per rail;
 //! - [`psd`]: stochastic irregularities from the ERRI (ORE B176) and FRA PSDs;
-//! - [`cases`]: the track cases of the Manchester benchmark and others.
+//! - [`cases`]: the track cases of the Manchester benchmark and others;
+//! - [`spec`]: serde descriptions of tracks (for RON scenario files).
 //!
 //! Conventions (DESIGN.md): SI units; SC0 x forward along the start of the
 //! track, y left, z up; s is the plan arc length; signed curvature κ > 0 turns
@@ -27,6 +28,7 @@ pub mod error;
 pub mod irregularity;
 pub mod profile;
 pub mod psd;
+pub mod spec;
 pub mod speed;
 pub mod track;
 
@@ -38,6 +40,7 @@ pub use irregularity::{
 };
 pub use profile::{PiecewiseLinear, VerticalPoint, VerticalProfile};
 pub use psd::{PsdModel, StochasticIrregularity, StochasticSpec};
+pub use spec::{IrregularitySpec, SectionSpec, TrackCase, TrackDescription, TrackSpec};
 pub use speed::{ArcMotion, ConstantSpeed, SpeedLaw, SpeedTable};
 pub use track::{
     STANDARD_GAUGE, STANDARD_GRAVITY, STANDARD_RAIL_DISTANCE, Track, TrackFrame, TrackPoint,

@@ -53,7 +53,7 @@ pub const FRA_A_V: [f64; 6] = [1.2107, 1.0181, 0.6816, 0.5376, 0.2095, 0.0339];
 pub const FRA_A_A: [f64; 6] = [3.3634, 1.2107, 0.4128, 0.3027, 0.0762, 0.0339];
 
 /// A published irregularity spectrum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum PsdModel {
     /// ERRI (ORE B176) low level.
     ErriLow,
