@@ -26,6 +26,14 @@ pub enum TrackError {
         /// Last valid arc position, m.
         end: f64,
     },
+    /// An output buffer has the wrong length.
+    #[error("input buffer has length {got}, expected {expected}")]
+    InputLength {
+        /// Required length.
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
     /// A parameter of a track description is invalid.
     #[error("invalid {what}: {reason}")]
     Invalid {

@@ -43,6 +43,6 @@ pub use psd::{PsdModel, StochasticIrregularity, StochasticSpec};
 pub use spec::{IrregularitySpec, SectionSpec, TrackCase, TrackDescription, TrackSpec};
 pub use speed::{ArcMotion, ConstantSpeed, SpeedLaw, SpeedTable};
 pub use track::{
-    STANDARD_GAUGE, STANDARD_GRAVITY, STANDARD_RAIL_DISTANCE, Track, TrackFrame, TrackPoint,
-    balancing_speed, cant_angle, cant_deficiency, uncompensated_lateral_acceleration,
+    FRAME_INPUTS, STANDARD_GAUGE, STANDARD_GRAVITY, STANDARD_RAIL_DISTANCE, Track, TrackFrame,
+    TrackPoint, balancing_speed, cant_angle, cant_deficiency, uncompensated_lateral_acceleration,
 };

@@ -99,6 +99,36 @@ pub struct TrackFrame {
     pub acceleration_local: [f64; 3],
     /// Angular acceleration resolved in the frame, rad/s².
     pub angular_acceleration_local: [f64; 3],
+    /// Rates of the angles (ψ̇, θ̇, φ̇), rad/s.
+    pub angle_rates: [f64; 3],
+    /// Second derivatives of the angles (ψ̈, θ̈, φ̈), rad/s².
+    pub angle_accelerations: [f64; 3],
+}
+
+/// Number of runtime inputs of one track-following frame: six pose components
+/// (x, y, z, yaw, pitch, roll), each as value, rate and acceleration.
+pub const FRAME_INPUTS: usize = 18;
+
+impl TrackFrame {
+    /// The rheonomic inputs of a model's track-following frame in the order the
+    /// engines take them (`railmbs_models::TRACK_FRAME_COMPONENTS`: x, y, z in
+    /// SC0, then yaw ψ, pitch θ, roll φ applied as Rz·Ry·Rx), each component as
+    /// (value, rate, acceleration): m, m/s, m/s² and rad, rad/s, rad/s².
+    pub fn rheonomic_inputs(&self) -> [f64; FRAME_INPUTS] {
+        let mut u = [0.0; FRAME_INPUTS];
+        for k in 0..3 {
+            u[3 * k] = self.position[k];
+            u[3 * k + 1] = self.velocity[k];
+            u[3 * k + 2] = self.acceleration[k];
+        }
+        let angles = [self.heading, self.pitch, self.roll];
+        for k in 0..3 {
+            u[9 + 3 * k] = angles[k];
+            u[9 + 3 * k + 1] = self.angle_rates[k];
+            u[9 + 3 * k + 2] = self.angle_accelerations[k];
+        }
+        u
+    }
 }
 
 impl Track {
@@ -332,6 +362,8 @@ impl Track {
             angular_velocity_local: tr(omega),
             acceleration_local: tr(acceleration),
             angular_acceleration_local: tr(omega_d),
+            angle_rates: [psi_d, th_d, ph_d],
+            angle_accelerations: [psi_dd, th_dd, ph_dd],
         })
     }
 
@@ -339,6 +371,42 @@ impl Track {
     pub fn frame_at_time(&self, speed: &impl SpeedLaw, t: f64) -> Result<TrackFrame, TrackError> {
         let ArcMotion { s, s_dot, s_ddot } = speed.motion(t)?;
         self.frame(s, s_dot, s_ddot)
+    }
+
+    /// The frame `offset` m ahead of the speed law's arc position (a vehicle's
+    /// frames sit at s(t) + offset, e.g. ± the bogie semi-spacing), at time `t`.
+    pub fn frame_at_time_offset(
+        &self,
+        speed: &impl SpeedLaw,
+        t: f64,
+        offset: f64,
+    ) -> Result<TrackFrame, TrackError> {
+        finite("frame offset", offset)?;
+        let ArcMotion { s, s_dot, s_ddot } = speed.motion(t)?;
+        self.frame(s + offset, s_dot, s_ddot)
+    }
+
+    /// Writes the rheonomic inputs ([`TrackFrame::rheonomic_inputs`]) of
+    /// frames at the given arc offsets (m) into `out` (length 18 × offsets), at
+    /// time `t`: what a model's `set_inputs` takes. No allocation.
+    pub fn write_inputs(
+        &self,
+        speed: &impl SpeedLaw,
+        t: f64,
+        offsets: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), TrackError> {
+        if out.len() != FRAME_INPUTS * offsets.len() {
+            return Err(TrackError::InputLength {
+                expected: FRAME_INPUTS * offsets.len(),
+                got: out.len(),
+            });
+        }
+        for (k, &off) in offsets.iter().enumerate() {
+            let f = self.frame_at_time_offset(speed, t, off)?;
+            out[FRAME_INPUTS * k..FRAME_INPUTS * (k + 1)].copy_from_slice(&f.rheonomic_inputs());
+        }
+        Ok(())
     }
 }
 

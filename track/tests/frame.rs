@@ -199,3 +199,54 @@ fn bad_inputs_are_errors() {
     .unwrap();
     assert!(Track::new(a).is_err());
 }
+
+#[test]
+fn rheonomic_inputs_are_consistent_rates() {
+    // Each input's rate and acceleration against central differences of its
+    // value and rate (same error budget as above), on a clothoid with cant ramp
+    // and a vertical curve, two frames 19 m apart.
+    let a = Alignment::new(vec![
+        Section::straight(30.0),
+        Section::clothoid(80.0, 0.0, 1.0 / 300.0).with_cant(0.0, -0.1),
+        Section::curve(50.0, 300.0, Direction::Left).with_cant(0.1, 0.1),
+    ])
+    .unwrap();
+    let track = Track::new(a).unwrap().with_vertical(
+        VerticalProfile::from_grade_knots(&[(0.0, 0.0), (150.0, -0.03)], 0.0).unwrap(),
+    );
+    let law = SpeedTable::new(60.0, &[(0.0, 15.0), (4.0, 25.0)]).unwrap();
+    let offsets = [9.5, -9.5];
+    let mut u = [0.0; 36];
+    let mut up = [0.0; 36];
+    let mut um = [0.0; 36];
+    let (t, h) = (1.5, 1e-4);
+    track.write_inputs(&law, t, &offsets, &mut u).unwrap();
+    track.write_inputs(&law, t + h, &offsets, &mut up).unwrap();
+    track.write_inputs(&law, t - h, &offsets, &mut um).unwrap();
+    for k in 0..12 {
+        let (v, r, acc) = (3 * k, 3 * k + 1, 3 * k + 2);
+        let fd_rate = (up[v] - um[v]) / (2.0 * h);
+        let fd_acc = (up[r] - um[r]) / (2.0 * h);
+        assert!(
+            (u[r] - fd_rate).abs() < 1e-6,
+            "input {k}: rate {} vs {fd_rate}",
+            u[r]
+        );
+        assert!(
+            (u[acc] - fd_acc).abs() < 1e-6,
+            "input {k}: acc {} vs {fd_acc}",
+            u[acc]
+        );
+    }
+    // Yaw, pitch and roll all move here.
+    for k in [3, 4, 5, 9, 10, 11] {
+        assert!(u[3 * k + 1].abs() > 1e-4, "input {k} rate {}", u[3 * k + 1]);
+    }
+    let f = track.frame_at_time_offset(&law, t, 9.5).unwrap();
+    assert_eq!(f.rheonomic_inputs()[..], u[..18]);
+    assert!(
+        track
+            .write_inputs(&law, t, &offsets, &mut [0.0; 35])
+            .is_err()
+    );
+}
