@@ -5,8 +5,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use railmbs_track::cases::{manchester_tc1, straight_lateral_irregularity};
-use railmbs_track::{ConstantSpeed, SpeedTable};
+use railmbs_track::cases::manchester_tc1;
+use railmbs_track::{
+    Component, ConstantSpeed, Irregularities, Irregularity, PsdModel, SpeedTable,
+    StochasticIrregularity, StochasticSpec,
+};
 
 fn bench(c: &mut Criterion) {
     let t = manchester_tc1().unwrap();
@@ -25,15 +28,24 @@ fn bench(c: &mut Criterion) {
     c.bench_function("deviation tc1 (dip)", |b| {
         b.iter(|| t.deviation(black_box(173.0)).unwrap())
     });
-    let s = straight_lateral_irregularity(2000.0, 1).unwrap();
-    c.bench_function("deviation stochastic 4000 harmonics", |b| {
-        b.iter(|| s.deviation(black_box(1000.0)).unwrap())
+    let irr = StochasticIrregularity::generate(&StochasticSpec {
+        model: PsdModel::ErriLow,
+        component: Component::Lateral,
+        wavelength_min: 3.0,
+        wavelength_max: 100.0,
+        harmonics: 1000,
+        seed: 1,
+        start: 0.0,
+        end: 3000.0,
+        fade: 20.0,
+    })
+    .unwrap();
+    let direct = Irregularities::new().with(Irregularity::Stochastic(irr.clone()));
+    c.bench_function("deviation stochastic 1000 harmonics", |b| {
+        b.iter(|| direct.deviation(black_box(1000.0)).unwrap())
     });
-    let irr = match &s.irregularities().items()[0] {
-        railmbs_track::Irregularity::Stochastic(x) => x.sampled(0.05).unwrap(),
-        _ => unreachable!("the case holds one stochastic irregularity"),
-    };
-    let tab = railmbs_track::Irregularities::new().with(railmbs_track::Irregularity::Measured(irr));
+    let irr = irr.sampled(0.05).unwrap();
+    let tab = Irregularities::new().with(Irregularity::Measured(irr));
     c.bench_function("deviation stochastic sampled 0.05 m", |b| {
         b.iter(|| tab.deviation(black_box(1000.0)).unwrap())
     });

@@ -64,6 +64,10 @@ pub struct TrackPoint {
 /// the frame axes in SC0 and v_SC0 = A·v_frame. Vectors named `*_local` are the
 /// same vectors resolved in the frame (Aᵀ·v), not relative derivatives; for the
 /// angular acceleration both coincide since ω × ω = 0.
+///
+/// The frame follows the design geometry; irregularities are deviations of the
+/// rails from it, resolved in it ([`Track::deviation`]). For a model's
+/// rheonomic joint use [`TrackFrame::rheonomic_inputs`] or [`Track::write_inputs`].
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TrackFrame {

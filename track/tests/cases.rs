@@ -103,11 +103,11 @@ fn high_speed_curve_case() {
 
 #[test]
 fn straight_lateral_irregularity_case() {
-    let t = straight_lateral_irregularity(2000.0, 42).unwrap();
+    let t = straight_lateral_irregularity(600.0, 42).unwrap();
     assert_eq!(t.deviation(40.0).unwrap().alignment(), 0.0);
-    let x = t.deviation(1000.0).unwrap();
+    let x = t.deviation(300.0).unwrap();
     assert!(x.alignment() != 0.0 && x.gauge() == 0.0 && x.level() == 0.0);
-    let u = straight_lateral_irregularity(2000.0, 42).unwrap();
-    assert_eq!(u.deviation(1234.5).unwrap(), t.deviation(1234.5).unwrap());
+    let u = straight_lateral_irregularity(600.0, 42).unwrap();
+    assert_eq!(u.deviation(234.5).unwrap(), t.deviation(234.5).unwrap());
     assert!(straight_lateral_irregularity(100.0, 1).is_err());
 }
