@@ -292,3 +292,35 @@ fn gauge_and_rail_inclination() {
     assert!(t.clone().with_rail_inclination(-0.1).is_err());
     assert!(t.with_gauge(0.0).is_err());
 }
+
+#[test]
+fn start_pose_rotates_and_shifts_the_alignment() {
+    use railmbs_track::PlanPose;
+    let secs = vec![
+        Section::straight(10.0),
+        Section::entry_transition(40.0, 200.0, Direction::Left),
+        Section::curve(30.0, 200.0, Direction::Left),
+    ];
+    let a = Alignment::new(secs.clone()).unwrap();
+    let (x0, y0, h0) = (100.0, -50.0, 0.7f64);
+    let b = Alignment::with_start(
+        secs,
+        PlanPose {
+            x: x0,
+            y: y0,
+            heading: h0,
+        },
+    )
+    .unwrap();
+    let (s, c) = h0.sin_cos();
+    for u in [0.0, 5.0, 33.0, 80.0] {
+        let (p, q) = (a.point(u).unwrap(), b.point(u).unwrap());
+        // Rigid motion: q = R(h0) p + (x0, y0), heading + h0.
+        assert!((q.x - (x0 + c * p.x - s * p.y)).abs() < 1e-12);
+        assert!((q.y - (y0 + s * p.x + c * p.y)).abs() < 1e-12);
+        assert!((q.heading - (p.heading + h0)).abs() < 1e-14);
+    }
+    let e = b.end_pose();
+    let q = b.point(80.0).unwrap();
+    assert!((e.x - q.x).abs() < 1e-12 && (e.heading - q.heading).abs() < 1e-15);
+}
