@@ -1,7 +1,7 @@
 //! Piecewise-linear functions of arc length: vertical grade (giving z(s) and
 //! pitch), design gauge widening.
 
-use crate::error::{TrackError, check_param, invalid};
+use crate::error::{TrackError, check_param, finite, invalid};
 
 /// A piecewise-linear function y(x) through knots with strictly increasing x,
 /// constant beyond the first and last knot, with its exact integral.
@@ -148,13 +148,14 @@ impl VerticalProfile {
         })
     }
 
-    /// Height, grade and its rate at `s`.
-    pub fn point(&self, s: f64) -> VerticalPoint {
+    /// Height, grade and its rate at `s` (m).
+    pub fn point(&self, s: f64) -> Result<VerticalPoint, TrackError> {
+        finite("arc position s", s)?;
         let (g, gr) = self.grade.value_slope(s);
-        VerticalPoint {
+        Ok(VerticalPoint {
             z: self.z0 + self.grade.integral(s) - self.grade.integral(0.0),
             grade: g,
             grade_rate: gr,
-        }
+        })
     }
 }

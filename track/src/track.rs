@@ -253,7 +253,7 @@ impl Track {
     /// Design geometry at `s` (m). No allocation.
     pub fn point(&self, s: f64) -> Result<TrackPoint, TrackError> {
         let plan = self.alignment.point(s)?;
-        let vertical = self.vertical.point(s);
+        let vertical = self.vertical.point(s)?;
         let (g, gp) = (vertical.grade, vertical.grade_rate);
         let q = 1.0 + g * g;
         // θ = −atan g: θ' = −g'/(1+g²), θ'' = 2 g g'²/(1+g²)² (g'' = 0 piecewise).
@@ -285,7 +285,8 @@ impl Track {
     }
 
     /// The track-following frame at arc position `s` (m) moving with `s_dot`
-    /// (m/s) and `s_ddot` (m/s²). No allocation.
+    /// (m/s) and `s_ddot` (m/s²). No allocation. `s` is the plan arc length, so
+    /// on a grade g the frame's 3-D speed is ṡ·√(1 + g²).
     ///
     /// Derivation: r(s) = (x, y, z), r' = (cos ψ, sin ψ, g), r'' = (−κ sin ψ,
     /// κ cos ψ, g'); v = r' ṡ, a = r'' ṡ² + r' s̈. ω = ψ̇ e_z + θ̇ Rz e_y + φ̇ Rz Ry e_x

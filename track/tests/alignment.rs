@@ -257,7 +257,7 @@ fn vertical_profile_grade_and_vertical_curve() {
     // 2 %: z = s²/(2Rv) on the curve, z = 1 + 0.02 (s − 100) after.
     let v = VerticalProfile::from_grade_knots(&[(0.0, 0.0), (100.0, 0.02)], 0.0).unwrap();
     for s in [0.0, 30.0, 100.0, 150.0, 300.0] {
-        let p = v.point(s);
+        let p = v.point(s).unwrap();
         let (z, g, gr) = if s <= 100.0 {
             (s * s / 10_000.0, s / 5000.0, 1.0 / 5000.0)
         } else {
