@@ -54,7 +54,7 @@ fn thread_cpu_seconds() -> Option<f64> {
     // SAFETY: clock_gettime only writes the timespec we own; on 64-bit Linux
     // (glibc and musl) struct timespec is two 64-bit integers.
     let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then(|| ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
+    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
 }
 
 #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
