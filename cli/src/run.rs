@@ -77,26 +77,41 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
 }
 
+/// Prints the run summary; a closed stdout (`umsim run … | head`) is not an error.
 fn print_summary(s: &RunSummary, output: Option<&std::path::Path>) {
-    println!("engine                 {}", s.engine);
-    println!("simulated time         {} s", s.t_end);
-    println!("steps                  {}", s.steps);
-    println!("rejected steps         {}", s.rejected_steps);
-    println!("Newton iterations      {}", s.newton_iterations);
-    println!("Jacobian evaluations   {}", s.jacobian_evaluations);
-    println!("equation evaluations   {}", s.dynamics_evaluations);
-    println!("CPU time               {:.4} s", s.cpu_time);
-    println!("real-time factor       {:.2}", s.realtime_factor());
+    use std::io::Write;
+    let text = summary_text(s, output);
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
+
+fn summary_text(s: &RunSummary, output: Option<&std::path::Path>) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    macro_rules! say {
+        ($($arg:tt)*) => {{
+            let _ = writeln!(out, $($arg)*);
+        }};
+    }
+    say!("engine                 {}", s.engine);
+    say!("simulated time         {} s", s.t_end);
+    say!("steps                  {}", s.steps);
+    say!("rejected steps         {}", s.rejected_steps);
+    say!("Newton iterations      {}", s.newton_iterations);
+    say!("Jacobian evaluations   {}", s.jacobian_evaluations);
+    say!("equation evaluations   {}", s.dynamics_evaluations);
+    say!("CPU time               {:.4} s", s.cpu_time);
+    say!("real-time factor       {:.2}", s.realtime_factor());
     if s.steps > 0 {
-        println!(
+        say!(
             "CPU time per step      {:.3} µs",
             1e6 * s.cpu_time / s.steps as f64
         );
     }
     match output {
-        Some(p) => println!("output                 {} ({} rows)", p.display(), s.rows),
+        Some(p) => say!("output                 {} ({} rows)", p.display(), s.rows),
         None => {
-            println!("output                 none (give -o FILE or output_file in the scenario)")
+            say!("output                 none (give -o FILE or output_file in the scenario)")
         }
     }
+    out
 }

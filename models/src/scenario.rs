@@ -63,6 +63,18 @@ pub struct OutputSpec {
     pub forces: Vec<String>,
 }
 
+/// The track a vehicle runs on (for models with track-following frames).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioTrack {
+    /// Track description file (RON, `railmbs_track::TrackDescription`),
+    /// resolved relative to the scenario file.
+    pub file: PathBuf,
+    /// Arc position of the vehicle's reference point at t = 0, m.
+    pub start: f64,
+    /// Running speed along the track, m/s (constant).
+    pub speed: f64,
+}
+
 /// A resolved scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
@@ -84,6 +96,9 @@ pub struct Scenario {
     /// Output CSV, resolved relative to the scenario file; the command line's
     /// `-o` overrides it.
     pub output_file: Option<PathBuf>,
+    /// Track and running speed, for models with track-following frames:
+    /// `track: (file: "../tracks/tc1.ron", start: 11.0, speed: 4.4)`.
+    pub track: Option<ScenarioTrack>,
 }
 
 use crate::error::{ModelError, ModelErrors};
@@ -117,6 +132,17 @@ struct RawScenario {
     output: RawOutput,
     #[serde(default, deserialize_with = "some")]
     output_file: Option<String>,
+    #[serde(default, deserialize_with = "some")]
+    track: Option<RawTrack>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTrack {
+    file: String,
+    #[serde(default)]
+    start: f64,
+    speed: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -294,6 +320,18 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
         };
         parameters.push((name, text));
     }
+    if let Some(tr) = &raw.track {
+        check(
+            tr.start.is_finite(),
+            "start",
+            format!("track start must be finite, got {}", tr.start),
+        );
+        check(
+            tr.speed.is_finite(),
+            "speed",
+            format!("track speed must be finite, got {} m/s", tr.speed),
+        );
+    }
     if !errors.is_empty() {
         errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
         return Err(ModelErrors(errors));
@@ -323,6 +361,11 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             forces: raw.output.forces,
         },
         output_file: raw.output_file.map(|f| dir.join(f)),
+        track: raw.track.map(|t| ScenarioTrack {
+            file: dir.join(t.file),
+            start: t.start,
+            speed: t.speed,
+        }),
     })
 }
 

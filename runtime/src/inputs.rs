@@ -18,6 +18,13 @@ pub trait InputProvider: Send {
     /// input, in the model's input order: for each track frame x, y, z in m,
     /// yaw, pitch, roll in rad; then per s and per s²) at time `t` (s).
     fn inputs(&mut self, t: f64, out: &mut [f64]) -> Result<(), SimError>;
+    /// Times in (t0, t1) at which an input's rate may jump (a kink in the
+    /// track: the ends of linear cant ramps, section joints), in increasing
+    /// order. A run stops there and restarts with velocities that keep every
+    /// body's absolute velocity continuous (`simulate::run_scenario`).
+    fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// An engine whose inputs come from a provider.

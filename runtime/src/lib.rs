@@ -14,6 +14,7 @@ pub mod numeric;
 pub mod plugin;
 pub mod simulate;
 pub mod system;
+pub mod track_inputs;
 
 pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
 pub use inputs::{DrivenEquations, InputProvider};
@@ -21,3 +22,4 @@ pub use model_system::ModelSystem;
 pub use numeric::NumericEquations;
 pub use plugin::{Plugin, PluginEquations, PluginError};
 pub use system::{MechanicalSystem, SimError};
+pub use track_inputs::TrackInputs;

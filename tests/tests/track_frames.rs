@@ -144,3 +144,94 @@ fn symbolic_equals_numeric_with_inputs() {
         assert!((&es.jacobians - &en.jacobians).abs().max() < 1e-12 * en.jacobians.abs().max());
     }
 }
+
+/// Largest deviation (m) of the free body from x = 11 + 4.4 t, y = z = 0 on
+/// track case 1 with Park at the given tolerance, and the number of rows.
+fn tc1_free_body_error(tol: f64) -> (f64, usize) {
+    let scenario_path = model_path("scenarios/track_free_body_tc1.ron");
+    let mut scenario =
+        railmbs_models::load_scenario(&scenario_path).unwrap_or_else(|e| panic!("{e}"));
+    scenario.integrator = railmbs_models::IntegratorSpec::Park {
+        rtol: tol,
+        atol: tol,
+        max_step: 0.05,
+        initial_step: None,
+        jacobian: railmbs_models::JacobianKind::FiniteDifference,
+    };
+    let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tc1.csv");
+    let summary = railmbs_runtime::simulate::run_scenario(
+        &scenario,
+        &model,
+        Box::new(NumericEquations::new(&model)),
+        Some(&out),
+        |_| {},
+    )
+    .unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    assert_eq!(
+        summary.rejected_steps, 0,
+        "steps rejected at the track's kinks"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ct, cx, cy, cz) = (
+        col("time"),
+        col("body.x[m]"),
+        col("body.y[m]"),
+        col("body.z[m]"),
+    );
+    let mut worst: f64 = 0.0;
+    let mut rows = 0;
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let t = v[ct];
+        worst = worst
+            .max((v[cx] - (11.0 + 4.4 * t)).abs())
+            .max(v[cy].abs())
+            .max(v[cz].abs());
+        rows += 1;
+    }
+    (worst, rows)
+}
+
+#[test]
+fn a_free_body_on_manchester_track_case_1_goes_straight_in_sc0() {
+    // At rest relative to its frame at t = 0 (s = 11 m on the straight lead-in,
+    // 4.4 m/s), the body keeps x = 11 + 4.4 t, y = z = 0 while the frame runs
+    // through the transitions, the cant ramps (whose ends are velocity kinks:
+    // the run restarts there with continuous absolute velocities) and the
+    // R = 150 m curve. The deviation is the global integration error: it falls
+    // with the tolerance (second order: about tol^(2/3)).
+    let (coarse, rows) = tc1_free_body_error(1e-8);
+    let (fine, _) = tc1_free_body_error(1e-10);
+    assert_eq!(rows, 81);
+    assert!(fine < 1e-5, "deviation {fine} m at tolerance 1e-10");
+    assert!(
+        coarse / fine > 8.0,
+        "deviation {coarse} → {fine} m does not fall with the tolerance"
+    );
+
+    // Missing track in the scenario: a clear error naming the scenario.
+    let scenario_path = model_path("scenarios/track_free_body_tc1.ron");
+    let mut scenario =
+        railmbs_models::load_scenario(&scenario_path).unwrap_or_else(|e| panic!("{e}"));
+    let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
+    scenario.track = None;
+    let err = railmbs_runtime::simulate::run_scenario(
+        &scenario,
+        &model,
+        Box::new(NumericEquations::new(&model)),
+        None,
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("track_free_body_tc1.ron") && err.contains("track"),
+        "{err}"
+    );
+}

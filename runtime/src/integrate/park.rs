@@ -240,6 +240,9 @@ impl ParkSettings {
 }
 
 /// Step-size controller constants.
+/// Consecutive rejected attempts of one step after which the history is
+/// dropped and the integration restarts with BDF1 from the current point.
+const RESTART_AFTER_REJECTIONS: usize = 3;
 const SAFETY: f64 = 0.9;
 const FAC_MIN: f64 = 0.2;
 /// Largest growth per step. Variable-step BDF formulas stay zero-stable for
@@ -1114,8 +1117,20 @@ impl Park {
         let mut jacobian_fresh = false;
         let mut beta_lu = f64::NAN;
         let mut rejected_last = false;
+        // Consecutive rejections of the current step. After a discontinuity in
+        // the forcing (a kink in the track's curvature, a friction mode
+        // change) the history polynomial spans the jump and its error estimate
+        // no longer falls with the step: restart from the current point with
+        // the one-step BDF1 (the start-up sequence builds the history again).
+        let mut consecutive_rejections = 0usize;
 
         while t < t_end {
+            if consecutive_rejections >= RESTART_AFTER_REJECTIONS && w.hlen > 1 {
+                w.hlen = 1;
+                consecutive_rejections = 0;
+                need_jacobian = true;
+                beta_lu = f64::NAN;
+            }
             // Step length, ending exactly at t_end and avoiding a sliver.
             let remaining = t_end - t;
             let (hs, t_new) = if s.fixed_step {
@@ -1195,6 +1210,7 @@ impl Park {
                 Newton::Failed(reason) => {
                     st.rejected_steps += 1;
                     st.newton_failures += 1;
+                    consecutive_rejections += 1;
                     eta = 1.0;
                     if !singular && beta_lu != beta {
                         // First retry: factorize for the exact β (cheap).
@@ -1244,6 +1260,7 @@ impl Park {
                 }
                 if err > 1.0 {
                     st.rejected_steps += 1;
+                    consecutive_rejections += 1;
                     h = hs * (SAFETY * err.powf(exponent)).clamp(FAC_MIN, 1.0);
                     rejected_last = true;
                     if h < s.min_step {
@@ -1269,6 +1286,7 @@ impl Park {
             }
 
             // Accept.
+            consecutive_rejections = 0;
             w.push_history(t_new);
             t = t_new;
             if s.consistent_multipliers && nc > 0 {

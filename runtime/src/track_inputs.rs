@@ -1,0 +1,100 @@
+//! The track as the input provider of a model's track-following frames.
+
+use crate::inputs::InputProvider;
+use crate::system::SimError;
+use railmbs_models::Model;
+use railmbs_track::{ConstantSpeed, SpeedLaw, Track};
+use std::sync::Arc;
+
+/// Drives every track-following frame of a model along a track: frame k sits
+/// at arc position s(t) + offset_k, with s(t) from the speed law. Implemented
+/// as an input provider for constant speed (what scenarios give), where the
+/// times at which frames pass the track's kinks are known in closed form.
+pub struct TrackInputs<S: SpeedLaw + Send> {
+    track: Arc<Track>,
+    speed: S,
+    /// Arc offsets of the frames, m.
+    offsets: Vec<f64>,
+}
+
+impl<S: SpeedLaw + Send> TrackInputs<S> {
+    /// The frames of `model` (offsets evaluated with `params`) on `track`.
+    pub fn for_model(
+        model: &Model,
+        params: &[f64],
+        track: Arc<Track>,
+        speed: S,
+    ) -> Result<Self, SimError> {
+        let offsets = model
+            .track_frames
+            .iter()
+            .map(|f| {
+                let x = f.offset.eval(params, 0.0);
+                if x.is_finite() {
+                    Ok(x)
+                } else {
+                    Err(SimError::Other(format!(
+                        "model \"{}\": the track offset of body \"{}\" is not finite ({x})",
+                        model.name, model.bodies[f.body].name
+                    )))
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            track,
+            speed,
+            offsets,
+        })
+    }
+}
+
+/// Arc positions where the track's design geometry has kinks: section joints
+/// (curvature rate and cant rate change there).
+fn kinks(track: &Track) -> Vec<f64> {
+    let a = track.alignment();
+    (1..a.sections().len())
+        .filter_map(|i| a.section_start(i))
+        .collect()
+}
+
+impl InputProvider for TrackInputs<ConstantSpeed> {
+    fn input_count(&self) -> usize {
+        6 * self.offsets.len()
+    }
+
+    fn inputs(&mut self, t: f64, out: &mut [f64]) -> Result<(), SimError> {
+        self.track
+            .write_inputs(&self.speed, t, &self.offsets, out)
+            .map_err(|e| SimError::Diverged {
+                t,
+                reason: format!("track-following frame: {e}"),
+            })
+    }
+
+    /// Frame k passes the kink at s_b at t = (s_b − offset_k − s0)/v.
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        let v = self.speed.v;
+        if v == 0.0 {
+            return Vec::new();
+        }
+        let mut times: Vec<f64> = kinks(&self.track)
+            .iter()
+            .flat_map(|&sb| {
+                self.offsets
+                    .iter()
+                    .map(move |off| (sb - off - self.speed.s0) / v)
+            })
+            .filter(|&t| t > t0 && t < t1)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        times
+    }
+}
+
+impl<S: SpeedLaw + Send> TrackInputs<S> {
+    /// The frames' arc offsets, m.
+    pub fn offsets(&self) -> &[f64] {
+        &self.offsets
+    }
+}
