@@ -17,6 +17,10 @@ pub struct ModelSystem {
     wrenches: Vec<Wrench>,
     dynamics_parts: Parts,
     jacobian_scratch: JacobianScratch,
+    /// Whether the force elements' states (friction modes, anchors) have been
+    /// set from an accepted state; the first evaluation sets them from the
+    /// initial state.
+    forces_initialized: bool,
     recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
 }
 
@@ -83,6 +87,7 @@ impl ModelSystem {
             wrenches: vec![Wrench::default(); nb],
             dynamics_parts,
             jacobian_scratch: JacobianScratch::new(model.coordinates.len()),
+            forces_initialized: false,
             recorder: None,
         })
     }
@@ -181,6 +186,9 @@ impl MechanicalSystem for ModelSystem {
         self.equations.constraint_count()
     }
 
+    /// The first call (at the initial state of a run) also initializes the
+    /// force elements' states there, as if that state had been accepted
+    /// (friction elements start sticking where they are at rest).
     fn dynamics(
         &mut self,
         t: f64,
@@ -189,6 +197,9 @@ impl MechanicalSystem for ModelSystem {
         mass: &mut DMatrix<f64>,
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
+        if !self.forces_initialized {
+            self.accept_forces(t, q, v);
+        }
         self.equations
             .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
         self.applied_forces(t, force)?;
@@ -276,6 +287,7 @@ impl MechanicalSystem for ModelSystem {
 
 impl ModelSystem {
     fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) {
+        self.forces_initialized = true;
         if self.forces.is_empty() {
             return;
         }
