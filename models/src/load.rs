@@ -1283,7 +1283,8 @@ impl Cx<'_> {
                         .collect();
                     if let Some(defs) = self.defaults.clone() {
                         let xs: Vec<f64> = rows.iter().map(|(x, _)| x.eval(&defs, 0.0)).collect();
-                        if let Some(k) = (1..xs.len()).find(|&k| !(xs[k] > xs[k - 1])) {
+                        if let Some(k) = (1..xs.len())
+                            .find(|&k| xs[k].partial_cmp(&xs[k - 1]) != Some(std::cmp::Ordering::Greater)) {
                             self.err(
                                 &w,
                                 Some("table"),

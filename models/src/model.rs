@@ -250,9 +250,9 @@ pub enum ForceKind {
         /// m.
         free_length: Expr,
     },
-    /// Tabulated force–deflection characteristic (bump stops): F = f(x − x0)
-    /// + d ẋ, f piecewise linear through the rows (deflection m, force N),
-    /// extended linearly beyond the first and last rows.
+    /// Tabulated force–deflection characteristic (bump stops):
+    /// F = f(x − x0) + d ẋ, with f piecewise linear through the rows
+    /// (deflection m, force N) and extended linearly beyond the end rows.
     Tabulated {
         body1: BodyRef,
         point1: [Expr; 3],

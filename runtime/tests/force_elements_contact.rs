@@ -32,14 +32,17 @@ fn system(model: &Model, overrides: &[(&str, String)]) -> (ModelSystem, Vec<f64>
     (sys, q0, v0)
 }
 
-/// Runs Park and returns the stats and the accepted states (t, q, v).
+/// An accepted state (t, q, v).
+type State = (f64, Vec<f64>, Vec<f64>);
+
+/// Runs Park and returns the stats and the accepted states.
 fn run(
     sys: &mut ModelSystem,
     q0: &[f64],
     v0: &[f64],
     t_end: f64,
     settings: &ParkSettings,
-) -> (IntegrationStats, Vec<(f64, Vec<f64>, Vec<f64>)>) {
+) -> (IntegrationStats, Vec<State>) {
     let mut states = Vec::new();
     let st = integrate_park(sys, settings, 0.0, q0, v0, t_end, |t, q, v, _| {
         states.push((t, q.to_vec(), v.to_vec()));
