@@ -11,6 +11,12 @@
 //! iterations, Jacobian and `dynamics` evaluations, and the largest
 //! difference of the final coordinates between the two runs.
 //!
+//! `jacobian/*` times one Jacobian evaluation at the final (resting, all
+//! contacts sticking) state: `MechanicalSystem::force_jacobian` against the
+//! 1 + 2n `dynamics` calls of forward differences (what Park spends per
+//! Jacobian with `JacobianKind::ForwardDifference`). How many Jacobians a run
+//! needs is Park's business (it reuses them while Newton converges fast).
+//!
 //! Run: `cargo bench -p railmbs-runtime --bench contacts`.
 
 use std::hint::black_box;
@@ -19,9 +25,10 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
 use railmbs_runtime::integrate::{IntegrationStats, JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{ModelSystem, NumericEquations};
+use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
 
 const T_END: f64 = 1.0;
 
@@ -34,6 +41,10 @@ fn model() -> Model {
 }
 
 fn run(model: &Model, kind: JacobianKind) -> IntegrationStats {
+    run_system(model, kind).0
+}
+
+fn run_system(model: &Model, kind: JacobianKind) -> (IntegrationStats, ModelSystem) {
     let params = model.parameter_values(&[], &[]).unwrap();
     let (q0, v0) = model.initial_state(&params);
     let mut sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
@@ -42,10 +53,11 @@ fn run(model: &Model, kind: JacobianKind) -> IntegrationStats {
         max_step: 0.01,
         ..ParkSettings::with_tolerances(1e-6, 1e-6)
     };
-    integrate_park(&mut sys, &settings, 0.0, &q0, &v0, T_END, |_, _, _, _| {
+    let st = integrate_park(&mut sys, &settings, 0.0, &q0, &v0, T_END, |_, _, _, _| {
         ControlFlow::Continue(())
     })
-    .unwrap_or_else(|e| panic!("{e}"))
+    .unwrap_or_else(|e| panic!("{e}"));
+    (st, sys)
 }
 
 fn contacts(c: &mut Criterion) {
@@ -84,5 +96,42 @@ fn contacts(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, contacts);
+fn jacobian(c: &mut Criterion) {
+    let model = model();
+    let (st, mut sys) = run_system(&model, JacobianKind::Analytic);
+    let (q, v) = (st.q.as_slice().to_vec(), st.v.as_slice().to_vec());
+    let n = q.len();
+    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+    let mut mass = DMatrix::zeros(n, n);
+    let (mut f0, mut f) = (DVector::zeros(n), DVector::zeros(n));
+    let mut group = c.benchmark_group("jacobian");
+    group.bench_function("analytic", |b| {
+        b.iter(|| {
+            sys.dynamics(0.0, &q, &v, &mut mass, &mut f0).unwrap();
+            sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap();
+            black_box(&dq);
+        })
+    });
+    group.bench_function("forward_difference", |b| {
+        b.iter(|| {
+            sys.dynamics(0.0, &q, &v, &mut mass, &mut f0).unwrap();
+            let (mut qp, mut vp) = (q.clone(), v.clone());
+            for j in 0..n {
+                let h = f64::EPSILON.sqrt() * q[j].abs().max(1.0);
+                qp[j] += h;
+                sys.dynamics(0.0, &qp, &v, &mut mass, &mut f).unwrap();
+                dq.set_column(j, &((&f - &f0) / h));
+                qp[j] = q[j];
+                vp[j] += h;
+                sys.dynamics(0.0, &q, &vp, &mut mass, &mut f).unwrap();
+                dv.set_column(j, &((&f - &f0) / h));
+                vp[j] = v[j];
+            }
+            black_box(&dq);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, jacobian, contacts);
 criterion_main!(benches);

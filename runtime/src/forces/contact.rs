@@ -26,8 +26,8 @@
 
 use super::nonlinear::{V_REG, V_STICK};
 use super::{
-    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
-    eval_vector,
+    Attachment, ForceContext, ForceElement, ForceJacobian, PairMatrix, Wrench, add_force,
+    eval_scalar, eval_vector, point_twist_map,
 };
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
@@ -421,13 +421,49 @@ impl ForceElement for PointPlane {
         }
     }
 
+    /// Sums the points' contributions in the twist coordinates of the two
+    /// bodies, Σ Gₖᵀ K_k Gₖ with Gₖ = [−S(ρ₁ₖ), S(ρ₂ₖ)] (3 × 12,
+    /// [`super::point_twist_map`]), and maps the 12×12 sums once with the body
+    /// Jacobians: the same as one point pair per point, at a fraction of the cost.
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
         let body = self.body();
+        let mut kq12 = PairMatrix::zeros();
+        let mut kv12 = PairMatrix::zeros();
+        let mut any = false;
         for k in 0..self.points.len() {
             if let Some(e) = self.evaluate(ctx, k) {
                 let (kq, kv) = self.local_jacobian(&e);
-                jac.add_point_pair(self.plane_body, &e.p, body, &e.p, &kq, &kv);
+                // Blocks Sᵢᵀ K Sⱼ with the signs of G = [−S₁, S₂], only for
+                // the sides that are bodies.
+                let s1 = self
+                    .plane_body
+                    .map(|b| point_twist_map(&(e.p - jac.body_position(b))));
+                let s2 = body.map(|b| point_twist_map(&(e.p - jac.body_position(b))));
+                for (k, acc) in [(&kq, &mut kq12), (&kv, &mut kv12)] {
+                    if let Some(s2) = &s2 {
+                        let ks2 = k * s2;
+                        let mut blk = acc.fixed_view_mut::<6, 6>(6, 6);
+                        blk += s2.transpose() * ks2;
+                        if let Some(s1) = &s1 {
+                            let mut blk = acc.fixed_view_mut::<6, 6>(0, 6);
+                            blk -= s1.transpose() * ks2;
+                        }
+                    }
+                    if let Some(s1) = &s1 {
+                        let ks1 = k * s1;
+                        let mut blk = acc.fixed_view_mut::<6, 6>(0, 0);
+                        blk += s1.transpose() * ks1;
+                        if let Some(s2) = &s2 {
+                            let mut blk = acc.fixed_view_mut::<6, 6>(6, 0);
+                            blk -= s2.transpose() * ks1;
+                        }
+                    }
+                }
+                any = true;
             }
+        }
+        if any {
+            jac.add_body_pair(self.plane_body, body, &kq12, &kv12);
         }
         Ok(())
     }

@@ -19,7 +19,10 @@ pub use nonlinear::{CoulombFriction, LoadFriction, Tabulated};
 
 use crate::equations::BodyKinematics;
 use crate::system::SimError;
-use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3};
+use nalgebra::{DMatrix, Matrix3, Matrix6, SMatrix, Vector3};
+
+/// 12×12 matrix over the twists (v, ω) of two bodies (body 1 first).
+pub type PairMatrix = SMatrix<f64, 12, 12>;
 use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model};
 
 /// Force (N) and moment about the centre of mass (N m) on one body, in SC0.
@@ -65,11 +68,13 @@ pub trait ForceElement: std::fmt::Debug + Send {
 /// Scratch buffers of [`ForceJacobian`] (kept by the system between calls).
 #[derive(Debug, Clone, Default)]
 pub struct JacobianScratch {
-    /// Up to 6 rows of a relative-motion Jacobian H (6 × n).
-    h: DMatrix<f64>,
-    /// Columns where H has non-zero entries.
+    /// Per body, the columns where its Γ_j has non-zero entries.
+    body_cols: Vec<Vec<usize>>,
+    /// Columns of the current pair (union of its two bodies'), m of them.
     cols: Vec<usize>,
-    /// K·H restricted to those columns (6 × cols).
+    /// Rows of the current relative-motion Jacobian H, row-major (rows × m).
+    h: Vec<f64>,
+    /// K·H (rows × m).
     kh: Vec<f64>,
 }
 
@@ -77,9 +82,10 @@ impl JacobianScratch {
     /// Buffers for `n` generalized coordinates.
     pub fn new(n: usize) -> Self {
         Self {
-            h: DMatrix::zeros(6, n),
+            body_cols: Vec::new(),
             cols: Vec::with_capacity(n),
-            kh: vec![0.0; 6 * n],
+            h: Vec::with_capacity(6 * n),
+            kh: Vec::with_capacity(6 * n),
         }
     }
 }
@@ -93,7 +99,8 @@ impl JacobianScratch {
 /// column by column (ρ from the centre of mass to the point, SC0) is the point
 /// Jacobian. Hence ∂Q/∂q ≈ Gᵀ (∂f₂/∂d) G and ∂Q/∂q̇ ≈ Gᵀ (∂f₂/∂ḋ) G, the terms
 /// with ∂Γ/∂q (proportional to the force itself) being neglected as in the
-/// seed paper, Sect. 6.
+/// seed paper, Sect. 6. Only the columns where the two bodies' Jacobians are
+/// non-zero (their coordinates and their ancestors') are visited.
 pub struct ForceJacobian<'a> {
     gamma: &'a DMatrix<f64>,
     bodies: &'a [crate::equations::BodyKinematics],
@@ -115,9 +122,15 @@ impl<'a> ForceJacobian<'a> {
         dv: &'a mut DMatrix<f64>,
         scratch: &'a mut JacobianScratch,
     ) -> Self {
-        let n = dq.ncols();
-        if scratch.h.ncols() != n {
-            *scratch = JacobianScratch::new(n);
+        let nb = gamma.nrows() / 6;
+        scratch.body_cols.resize_with(nb, Vec::new);
+        for (j, cols) in scratch.body_cols.iter_mut().enumerate() {
+            cols.clear();
+            for i in 0..gamma.ncols() {
+                if (0..6).any(|r| gamma[(6 * j + r, i)] != 0.0) {
+                    cols.push(i);
+                }
+            }
         }
         Self {
             gamma,
@@ -128,17 +141,59 @@ impl<'a> ForceJacobian<'a> {
         }
     }
 
+    /// Starts a pair: the union of the bodies' columns, H zeroed (`rows` rows).
+    fn begin(&mut self, body1: Option<usize>, body2: Option<usize>, rows: usize) {
+        let s = &mut *self.scratch;
+        s.cols.clear();
+        let empty: &[usize] = &[];
+        let a = body1.map_or(empty, |b| &s.body_cols[b]);
+        let b = body2.map_or(empty, |b| &s.body_cols[b]);
+        // Merge two sorted lists.
+        let (mut i, mut k) = (0, 0);
+        while i < a.len() || k < b.len() {
+            let next = match (a.get(i), b.get(k)) {
+                (Some(&x), Some(&y)) if x == y => {
+                    i += 1;
+                    k += 1;
+                    x
+                }
+                (Some(&x), Some(&y)) if x < y => {
+                    i += 1;
+                    x
+                }
+                (Some(_), Some(&y)) => {
+                    k += 1;
+                    y
+                }
+                (Some(&x), None) => {
+                    i += 1;
+                    x
+                }
+                (None, Some(&y)) => {
+                    k += 1;
+                    y
+                }
+                (None, None) => break,
+            };
+            s.cols.push(next);
+        }
+        s.h.clear();
+        s.h.resize(rows * s.cols.len(), 0.0);
+    }
+
     /// Adds `sign`·Γ_P of the point `p` (SC0) of `body` to rows row0..row0+3 of H.
     fn point_rows(&mut self, row0: usize, body: Option<usize>, p: &Vector3<f64>, sign: f64) {
         let Some(b) = body else { return };
         let rho = p - self.bodies[b].position;
         let g = self.gamma;
-        for i in 0..g.ncols() {
+        let s = &mut *self.scratch;
+        let m = s.cols.len();
+        for (ci, &i) in s.cols.iter().enumerate() {
             let w = Vector3::new(g[(6 * b + 3, i)], g[(6 * b + 4, i)], g[(6 * b + 5, i)]);
             let v = Vector3::new(g[(6 * b, i)], g[(6 * b + 1, i)], g[(6 * b + 2, i)]);
             let c = v + w.cross(&rho);
             for k in 0..3 {
-                self.scratch.h[(row0 + k, i)] += sign * c[k];
+                s.h[(row0 + k) * m + ci] += sign * c[k];
             }
         }
     }
@@ -146,16 +201,17 @@ impl<'a> ForceJacobian<'a> {
     /// Adds `sign`·Γ_r of `body` to rows row0..row0+3 of H.
     fn rotation_rows(&mut self, row0: usize, body: Option<usize>, sign: f64) {
         let Some(b) = body else { return };
-        for i in 0..self.gamma.ncols() {
+        let s = &mut *self.scratch;
+        let m = s.cols.len();
+        for (ci, &i) in s.cols.iter().enumerate() {
             for k in 0..3 {
-                self.scratch.h[(row0 + k, i)] += sign * self.gamma[(6 * b + 3 + k, i)];
+                s.h[(row0 + k) * m + ci] += sign * self.gamma[(6 * b + 3 + k, i)];
             }
         }
     }
 
-    /// Adds Hᵀ kq H to `dq` and Hᵀ kv H to `dv` for the first `rows` rows of H
-    /// (kq, kv given as closures over (row, col) of the rows × rows matrices),
-    /// then clears H.
+    /// Adds Hᵀ kq H to `dq` and Hᵀ kv H to `dv` (kq, kv given as closures
+    /// over (row, col) of the rows × rows matrices).
     fn project(
         &mut self,
         rows: usize,
@@ -163,42 +219,34 @@ impl<'a> ForceJacobian<'a> {
         kv: impl Fn(usize, usize) -> f64,
     ) {
         let s = &mut *self.scratch;
-        s.cols.clear();
-        for i in 0..s.h.ncols() {
-            if (0..rows).any(|r| s.h[(r, i)] != 0.0) {
-                s.cols.push(i);
-            }
-        }
-        let nc = s.cols.len();
+        let m = s.cols.len();
+        s.kh.clear();
+        s.kh.resize(rows * m, 0.0);
         for (pass, out) in [(0, &mut *self.dq), (1, &mut *self.dv)] {
             let k = |r: usize, c: usize| if pass == 0 { kq(r, c) } else { kv(r, c) };
-            // KH (rows × nc).
             let mut any = false;
             for r in 0..rows {
-                for (ci, &col) in s.cols.iter().enumerate() {
+                for ci in 0..m {
                     let mut acc = 0.0;
-                    for m in 0..rows {
-                        acc += k(r, m) * s.h[(m, col)];
+                    for l in 0..rows {
+                        acc += k(r, l) * s.h[l * m + ci];
                     }
-                    s.kh[r * nc + ci] = acc;
+                    s.kh[r * m + ci] = acc;
                     any |= acc != 0.0;
                 }
             }
             if !any {
                 continue;
             }
-            for &a in &s.cols {
-                for (ci, &b) in s.cols.iter().enumerate() {
+            for (ai, &a) in s.cols.iter().enumerate() {
+                for (bi, &b) in s.cols.iter().enumerate() {
                     let mut acc = 0.0;
                     for r in 0..rows {
-                        acc += s.h[(r, a)] * s.kh[r * nc + ci];
+                        acc += s.h[r * m + ai] * s.kh[r * m + bi];
                     }
                     out[(a, b)] += acc;
                 }
             }
-        }
-        for r in 0..rows {
-            s.h.row_mut(r).fill(0.0);
         }
     }
 
@@ -217,9 +265,43 @@ impl<'a> ForceJacobian<'a> {
         if body1.is_none() && body2.is_none() {
             return;
         }
+        self.begin(body1, body2, 3);
         self.point_rows(0, body2, p2, 1.0);
         self.point_rows(0, body1, p1, -1.0);
         self.project(3, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
+    }
+
+    /// Adds Hᵀ kq H and Hᵀ kv H with H = [Γ₁; Γ₂] (12 × n), the stacked body
+    /// Jacobians of `body1` and `body2` (a ground side contributes zero rows):
+    /// for elements that sum many point contributions between the same two
+    /// bodies in twist coordinates first ([`point_twist_map`]).
+    pub fn add_body_pair(
+        &mut self,
+        body1: Option<usize>,
+        body2: Option<usize>,
+        kq: &PairMatrix,
+        kv: &PairMatrix,
+    ) {
+        if body1.is_none() && body2.is_none() {
+            return;
+        }
+        self.begin(body1, body2, 12);
+        let s = &mut *self.scratch;
+        let m = s.cols.len();
+        for (row0, body) in [(0, body1), (6, body2)] {
+            let Some(b) = body else { continue };
+            for (ci, &i) in s.cols.iter().enumerate() {
+                for k in 0..6 {
+                    s.h[(row0 + k) * m + ci] = self.gamma[(6 * b + k, i)];
+                }
+            }
+        }
+        self.project(12, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
+    }
+
+    /// Position of body `b`'s centre of mass (SC0), m.
+    pub fn body_position(&self, b: usize) -> Vector3<f64> {
+        self.bodies[b].position
     }
 
     /// A wrench w = (force, moment) expressed in a frame with direction cosines
@@ -240,26 +322,41 @@ impl<'a> ForceJacobian<'a> {
         if body1.is_none() && body2.is_none() {
             return;
         }
+        self.begin(body1, body2, 6);
         self.point_rows(0, body2, p, 1.0);
         self.point_rows(0, body1, p, -1.0);
         self.rotation_rows(3, body2, 1.0);
         self.rotation_rows(3, body1, -1.0);
         // Rotate the rows into the frame: H ← diag(a1ᵀ, a1ᵀ) H.
         let at = a1.transpose();
-        let h = &mut self.scratch.h;
-        for i in 0..h.ncols() {
+        let s = &mut *self.scratch;
+        let m = s.cols.len();
+        for ci in 0..m {
             for blk in [0, 3] {
-                let x = Vector3::new(h[(blk, i)], h[(blk + 1, i)], h[(blk + 2, i)]);
-                if x != Vector3::zeros() {
-                    let y = at * x;
-                    for k in 0..3 {
-                        h[(blk + k, i)] = y[k];
-                    }
+                let x = Vector3::new(
+                    s.h[blk * m + ci],
+                    s.h[(blk + 1) * m + ci],
+                    s.h[(blk + 2) * m + ci],
+                );
+                let y = at * x;
+                for k in 0..3 {
+                    s.h[(blk + k) * m + ci] = y[k];
                 }
             }
         }
         self.project(6, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
     }
+}
+
+/// S = [E, −(ρ×)] (3 × 6): the velocity of a point at ρ from a body's centre
+/// of mass from the body's twist (v, ω), v_P = v + ω × ρ.
+pub fn point_twist_map(rho: &Vector3<f64>) -> SMatrix<f64, 3, 6> {
+    let mut s = SMatrix::<f64, 3, 6>::zeros();
+    s.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&Matrix3::identity());
+    s.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-rho.cross_matrix()));
+    s
 }
 
 /// Builds the runtime force elements of a model.
