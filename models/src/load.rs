@@ -1002,7 +1002,12 @@ impl Cx<'_> {
         if let Some(d) = &self.defaults {
             let x = e.eval(d, 0.0);
             if x.is_finite() && x <= 0.0 {
-                self.err(w, Some(key), None, format!("{key} must be positive, got {x}"));
+                self.err(
+                    w,
+                    Some(key),
+                    None,
+                    format!("{key} must be positive, got {x}"),
+                );
             }
         }
     }
@@ -1012,7 +1017,12 @@ impl Cx<'_> {
         if let Some(d) = &self.defaults {
             let x = e.eval(d, 0.0);
             if x.is_finite() && x < 0.0 {
-                self.err(w, Some(key), None, format!("{key} must not be negative, got {x}"));
+                self.err(
+                    w,
+                    Some(key),
+                    None,
+                    format!("{key} must not be negative, got {x}"),
+                );
             }
         }
     }
@@ -1023,7 +1033,12 @@ impl Cx<'_> {
         if let Some(d) = &self.defaults {
             let (s, s0) = (sliding.eval(d, 0.0), stat.eval(d, 0.0));
             if s.is_finite() && s < 0.0 {
-                self.err(w, Some(key), None, format!("{key} must not be negative, got {s}"));
+                self.err(
+                    w,
+                    Some(key),
+                    None,
+                    format!("{key} must not be negative, got {s}"),
+                );
             } else if s.is_finite() && s0.is_finite() && s > s0 {
                 self.err(
                     w,
@@ -1283,8 +1298,9 @@ impl Cx<'_> {
                         .collect();
                     if let Some(defs) = self.defaults.clone() {
                         let xs: Vec<f64> = rows.iter().map(|(x, _)| x.eval(&defs, 0.0)).collect();
-                        if let Some(k) = (1..xs.len())
-                            .find(|&k| xs[k].partial_cmp(&xs[k - 1]) != Some(std::cmp::Ordering::Greater)) {
+                        if let Some(k) = (1..xs.len()).find(|&k| {
+                            xs[k].partial_cmp(&xs[k - 1]) != Some(std::cmp::Ordering::Greater)
+                        }) {
                             self.err(
                                 &w,
                                 Some("table"),
