@@ -70,8 +70,12 @@ pub enum ContactMode {
     Free,
     /// Sticking to the anchor, given in the plane body's frame (m).
     Stick { anchor: Vector3<f64> },
-    /// Sliding; `dir` the unit tangential velocity (SC0) at the last accepted step.
-    Slide { dir: Vector3<f64> },
+    /// Sliding; `dir` the unit sliding direction (SC0) at the last accepted
+    /// step; `established` once the sliding speed has reached [`V_STICK`].
+    Slide {
+        dir: Vector3<f64>,
+        established: bool,
+    },
 }
 
 /// Point–plane contact of any number of points; see the module docs.
@@ -395,26 +399,40 @@ impl ForceElement for PointPlane {
                 anchor: this.to_plane(ctx, &(e.p + e.ft / this.ct)),
             };
             self.modes[k] = match (self.modes[k], e.branch) {
-                (ContactMode::Stick { .. }, Tangential::Saturated(_)) => ContactMode::Slide {
-                    dir: if speed > 0.0 {
-                        e.vt / speed
-                    } else {
-                        Vector3::zeros()
-                    },
+                // Breakaway: the point will slip against the friction force.
+                (ContactMode::Stick { .. }, Tangential::Saturated(u)) => ContactMode::Slide {
+                    dir: -u,
+                    established: speed >= V_STICK,
                 },
                 (ContactMode::Stick { anchor }, _) => ContactMode::Stick { anchor },
-                (ContactMode::Slide { dir }, _) => {
-                    if speed < V_STICK || e.vt.dot(&dir) <= 0.0 {
+                (ContactMode::Slide { dir, established }, _) => {
+                    // Sticks again when the slip has reversed or slowed below
+                    // V_STICK; right after a breakaway (slip not yet at
+                    // V_STICK) only a clear reversal counts.
+                    let est = established || speed >= V_STICK;
+                    let along = e.vt.dot(&dir);
+                    let stop = if est {
+                        along <= 0.0 || speed < V_STICK
+                    } else {
+                        along < -V_STICK
+                    };
+                    if stop {
                         stick_here(self)
                     } else {
-                        ContactMode::Slide { dir: e.vt / speed }
+                        ContactMode::Slide {
+                            dir: if speed > V_REG { e.vt / speed } else { dir },
+                            established: est,
+                        }
                     }
                 }
                 (ContactMode::Free, _) => {
                     if speed < V_STICK {
                         stick_here(self)
                     } else {
-                        ContactMode::Slide { dir: e.vt / speed }
+                        ContactMode::Slide {
+                            dir: e.vt / speed,
+                            established: true,
+                        }
                     }
                 }
             };

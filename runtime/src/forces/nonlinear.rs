@@ -155,8 +155,9 @@ pub enum FrictionMode {
     /// Sticking with the stored force f0 (N) at the stored length x0 (m).
     Stick { f0: f64, x0: f64 },
     /// Sliding; `dir` is the sign of ẋ when the mode was entered or last
-    /// confirmed.
-    Slide { dir: f64 },
+    /// confirmed; `established` once the sliding speed has reached
+    /// [`V_STICK`].
+    Slide { dir: f64, established: bool },
 }
 
 /// Bipolar Coulomb friction: sticking F = f0 + c (x − x0) + d ẋ (f0, x0
@@ -300,18 +301,30 @@ impl ForceElement for CoulombFriction {
         let s = self.pair.state(ctx);
         let (f, _, _, branch) = self.law(s.length, s.rate);
         self.mode = match (self.mode, branch) {
-            (FrictionMode::Stick { .. }, Branch::Saturated(sign)) => {
-                FrictionMode::Slide { dir: sign }
-            }
+            (FrictionMode::Stick { .. }, Branch::Saturated(sign)) => FrictionMode::Slide {
+                dir: sign,
+                established: s.rate.abs() >= V_STICK,
+            },
             (FrictionMode::Stick { .. }, _) => self.mode,
-            (FrictionMode::Slide { dir }, _) => {
-                if s.rate * dir <= 0.0 || s.rate.abs() < V_STICK {
+            (FrictionMode::Slide { dir, established }, _) => {
+                // As for the contacts: after a breakaway only a clear
+                // reversal stops the slip until it has reached V_STICK.
+                let est = established || s.rate.abs() >= V_STICK;
+                let stop = if est {
+                    s.rate * dir <= 0.0 || s.rate.abs() < V_STICK
+                } else {
+                    s.rate * dir < -V_STICK
+                };
+                if stop {
                     FrictionMode::Stick {
                         f0: f,
                         x0: s.length,
                     }
                 } else {
-                    FrictionMode::Slide { dir }
+                    FrictionMode::Slide {
+                        dir,
+                        established: est,
+                    }
                 }
             }
             (FrictionMode::Initial, _) => {
@@ -323,6 +336,7 @@ impl ForceElement for CoulombFriction {
                 } else {
                     FrictionMode::Slide {
                         dir: s.rate.signum(),
+                        established: true,
                     }
                 }
             }
@@ -422,7 +436,7 @@ impl LoadFriction {
     /// (F, ∂F/∂x, x2, branch) at deflection x (m) and rate v.
     fn law(&self, x: f64, v: f64) -> (f64, f64, f64, Branch) {
         match self.mode {
-            FrictionMode::Slide { dir } => {
+            FrictionMode::Slide { dir, .. } => {
                 let (f, k, x2) = self.sliding(x, dir, self.mu);
                 (f, k, x2, Branch::Slide)
             }
@@ -500,8 +514,14 @@ impl ForceElement for LoadFriction {
         let s = self.pair.state(ctx);
         let (_, _, x2, branch) = self.law(s.length - self.free_length, s.rate);
         self.mode = match (self.mode, branch) {
-            (_, Branch::Saturated(sign)) => FrictionMode::Slide { dir: sign },
-            (FrictionMode::Slide { dir }, _) if s.rate * dir > 0.0 => FrictionMode::Slide { dir },
+            (_, Branch::Saturated(sign)) => FrictionMode::Slide {
+                dir: sign,
+                established: true,
+            },
+            (FrictionMode::Slide { dir, .. }, _) if s.rate * dir > 0.0 => FrictionMode::Slide {
+                dir,
+                established: true,
+            },
             _ => FrictionMode::Stick { f0: 0.0, x0: 0.0 },
         };
         self.x2 = x2;
