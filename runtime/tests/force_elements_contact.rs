@@ -616,7 +616,7 @@ fn block_on_a_moving_belt_shows_the_stick_slip_cycle() {
     let model = parse(BELT);
     let (mut sys, q0, v0) = system(&model, &[]);
     let (_, states) = run(&mut sys, &q0, &v0, 1.5, &settings(1e-7, 1e-7, 1e-3));
-    let (m, g, k, mu0, mu, vb) = (1.0, 9.81, 1000.0, 0.4, 0.3, 0.1);
+    let (m, g, k, mu0, mu, vb) = (1.0f64, 9.81f64, 1000.0f64, 0.4f64, 0.3f64, 0.1f64);
     // Sticking: the block rides with the belt until the spring force k x
     // reaches μ0 m g, at x0 = μ0 m g/k; sliding: harmonic motion about
     // x_s = μ m g/k starting at x0 with the belt's speed,
@@ -624,7 +624,7 @@ fn block_on_a_moving_belt_shows_the_stick_slip_cycle() {
     // x_s ± A, A = √((x0 − x_s)² + (v_b/ω)²); it ends (relative velocity zero
     // again) at the mirror point 2 x_s − x0, where the block sticks and rides
     // with the belt up to x0 again.
-    let w = (k / m as f64).sqrt();
+    let w = (k / m).sqrt();
     let (x0, xs) = (mu0 * m * g / k, mu * m * g / k);
     let amp = ((x0 - xs).powi(2) + (vb / w).powi(2)).sqrt();
     let late: Vec<_> = states.iter().filter(|(t, ..)| *t > 0.5).collect();
