@@ -99,7 +99,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         "derive + CSE           {:.4} s",
         (g.derive_time + s.cse_time).as_secs_f64()
     );
-    println!("source formatting      {:.4} s", s.format_time.as_secs_f64());
+    println!(
+        "source formatting      {:.4} s",
+        s.format_time.as_secs_f64()
+    );
     match built.compile_time {
         Some(t) => println!(
             "compile time           {:.3} s (cache miss)",
