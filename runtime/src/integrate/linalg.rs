@@ -173,3 +173,97 @@ mod tests {
         assert!(!lu.is_valid());
     }
 }
+
+/// In-place Cholesky factorization M = L Lᵀ of a symmetric positive definite
+/// matrix (column-major, only the lower triangle is read and overwritten by L).
+/// Column-oriented ("left-looking") so that every inner loop runs down a
+/// contiguous column. Returns `false` if a pivot is not positive (M not
+/// positive definite, or not finite).
+pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
+    let n = m.nrows();
+    let data = m.as_mut_slice();
+    for j in 0..n {
+        let (left, right) = data.split_at_mut(j * n);
+        let col_j = &mut right[..n];
+        for k in 0..j {
+            let col_k = &left[k * n..(k + 1) * n];
+            let ljk = col_k[j];
+            if ljk != 0.0 {
+                for i in j..n {
+                    col_j[i] -= col_k[i] * ljk;
+                }
+            }
+        }
+        let d = col_j[j];
+        if !(d > 0.0) || !d.is_finite() {
+            return false;
+        }
+        let ljj = d.sqrt();
+        col_j[j] = ljj;
+        let inv = 1.0 / ljj;
+        for x in &mut col_j[j + 1..] {
+            *x *= inv;
+        }
+    }
+    true
+}
+
+/// Solves L Lᵀ x = b in place with the factor of [`cholesky_in_place`].
+pub(crate) fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
+    let n = l.nrows();
+    let data = l.as_slice();
+    // L y = b
+    for j in 0..n {
+        let col = &data[j * n..(j + 1) * n];
+        let yj = b[j] / col[j];
+        b[j] = yj;
+        if yj != 0.0 {
+            for i in j + 1..n {
+                b[i] -= col[i] * yj;
+            }
+        }
+    }
+    // Lᵀ x = y
+    for j in (0..n).rev() {
+        let col = &data[j * n..(j + 1) * n];
+        let mut s = b[j];
+        for i in j + 1..n {
+            s -= col[i] * b[i];
+        }
+        b[j] = s / col[j];
+    }
+}
+
+#[cfg(test)]
+mod cholesky_tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solves_spd_systems_like_nalgebra_and_refuses_indefinite_ones() {
+        // Deterministic SPD matrices A = B Bᵀ + n·I.
+        for n in [1usize, 2, 5, 13, 30] {
+            let b = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4);
+            let a = &b * b.transpose() + DMatrix::identity(n, n) * n as f64;
+            let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let mut l = a.clone();
+            assert!(cholesky_in_place(&mut l));
+            let mut x = rhs.clone();
+            cholesky_solve(&l, &mut x);
+            let expect = a
+                .clone()
+                .cholesky()
+                .unwrap()
+                .solve(&nalgebra::DVector::from_vec(rhs));
+            for (u, w) in x.iter().zip(expect.iter()) {
+                assert!(
+                    (u - w).abs() < 1e-12 * (1.0 + w.abs()),
+                    "n = {n}: {u} vs {w}"
+                );
+            }
+        }
+        let mut indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(!cholesky_in_place(&mut indefinite));
+        let mut nan = DMatrix::from_row_slice(1, 1, &[f64::NAN]);
+        assert!(!cholesky_in_place(&mut nan));
+    }
+}
