@@ -195,7 +195,7 @@ pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
             }
         }
         let d = col_j[j];
-        if !(d > 0.0) || !d.is_finite() {
+        if d.is_nan() || d <= 0.0 || d.is_infinite() {
             return false;
         }
         let ljj = d.sqrt();
