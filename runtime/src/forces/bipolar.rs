@@ -1,11 +1,113 @@
-//! Linear bipolar viscoelastic element (seed paper Sect. 3.1).
+//! Two-point (bipolar) elements: the geometry shared by every element acting
+//! along the line of two points ([`TwoPoint`]), and the linear viscoelastic
+//! element (seed paper Sect. 3.1).
 
 use super::{
     Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
 };
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{Expr, ForceKind};
+use railmbs_models::{BodyRef, Expr, ForceKind};
+
+/// Two attachment points and the kinematics of their distance.
+#[derive(Debug, Clone)]
+pub(crate) struct TwoPoint {
+    ends: [Attachment; 2],
+}
+
+/// Distance x (m), its rate (m/s), unit vector from end 1 to end 2 (None at
+/// zero length), the end positions (SC0).
+pub(crate) struct PairState {
+    pub length: f64,
+    pub rate: f64,
+    pub direction: Option<Vector3<f64>>,
+    pub p1: Vector3<f64>,
+    pub p2: Vector3<f64>,
+    pub relative_velocity: Vector3<f64>,
+}
+
+impl TwoPoint {
+    pub fn new(b1: BodyRef, p1: &[Expr; 3], b2: BodyRef, p2: &[Expr; 3]) -> Self {
+        Self {
+            ends: [Attachment::new(b1, p1), Attachment::new(b2, p2)],
+        }
+    }
+
+    pub fn set_parameters(&mut self, params: &[f64], owner: &str) -> Result<(), SimError> {
+        for e in &mut self.ends {
+            e.set_parameters(params, owner)?;
+        }
+        Ok(())
+    }
+
+    pub fn state(&self, ctx: &ForceContext) -> PairState {
+        let p1 = self.ends[0].position(ctx);
+        let p2 = self.ends[1].position(ctx);
+        let dv = self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx);
+        let d = p2 - p1;
+        let length = d.norm();
+        if length <= f64::MIN_POSITIVE {
+            return PairState {
+                length: 0.0,
+                rate: 0.0,
+                direction: None,
+                p1,
+                p2,
+                relative_velocity: dv,
+            };
+        }
+        let e = d / length;
+        PairState {
+            length,
+            rate: dv.dot(&e),
+            direction: Some(e),
+            p1,
+            p2,
+            relative_velocity: dv,
+        }
+    }
+
+    /// Applies the tension `f` (N, positive pulls the ends together).
+    pub fn apply(&self, ctx: &ForceContext, s: &PairState, f: f64, wrenches: &mut [Wrench]) {
+        let Some(e) = s.direction else { return };
+        let fv = f * e;
+        add_force(wrenches, ctx, self.ends[0].body, &s.p1, &fv);
+        add_force(wrenches, ctx, self.ends[1].body, &s.p2, &(-fv));
+    }
+
+    /// Adds the Jacobian of a tension F(x, ẋ) with ∂F/∂x = `dfdx`, ∂F/∂ẋ =
+    /// `dfdv`: for f₂ = −F e, ∂f₂/∂d = −[e (F_x e + F_v (E − e eᵀ) ḋ/x)ᵀ +
+    /// (F/x)(E − e eᵀ)] and ∂f₂/∂ḋ = −F_v e eᵀ.
+    pub fn add_jacobian(
+        &self,
+        s: &PairState,
+        f: f64,
+        dfdx: f64,
+        dfdv: f64,
+        jac: &mut ForceJacobian,
+    ) {
+        let Some(e) = s.direction else { return };
+        let (kq, kv) = bipolar_jacobian(&e, s.length, &s.relative_velocity, f, dfdx, dfdv);
+        jac.add_point_pair(self.ends[0].body, &s.p1, self.ends[1].body, &s.p2, &kq, &kv);
+    }
+}
+
+/// Local Jacobians (∂f₂/∂d, ∂f₂/∂ḋ) of a bipolar tension F(x, ẋ), see
+/// [`TwoPoint::add_jacobian`].
+pub(crate) fn bipolar_jacobian(
+    e: &Vector3<f64>,
+    x: f64,
+    dd: &Vector3<f64>,
+    f: f64,
+    dfdx: f64,
+    dfdv: f64,
+) -> (Matrix3<f64>, Matrix3<f64>) {
+    let transverse = Matrix3::identity() - e * e.transpose();
+    let g = dfdx * e + dfdv * (transverse * dd) / x;
+    let kq = -(e * g.transpose() + (f / x) * transverse);
+    let kv = -dfdv * e * e.transpose();
+    (kq, kv)
+}
 
 /// Spring–damper between two points: F = c (x − x0) + d ẋ + f0 along the line of
 /// the points, x their distance (m). A positive F is tension: it pulls the
@@ -14,7 +116,7 @@ use railmbs_models::{Expr, ForceKind};
 #[derive(Debug, Clone)]
 pub struct LinearBipolar {
     name: String,
-    ends: [Attachment; 2],
+    pair: TwoPoint,
     exprs: [Expr; 4],
     /// N/m.
     pub stiffness: f64,
@@ -24,13 +126,6 @@ pub struct LinearBipolar {
     pub preload: f64,
     /// m.
     pub free_length: f64,
-}
-
-/// Length (m), its rate (m/s), unit vector from end 1 to end 2.
-pub(crate) struct Deflection {
-    pub length: f64,
-    pub rate: f64,
-    pub direction: Option<nalgebra::Vector3<f64>>,
 }
 
 impl LinearBipolar {
@@ -51,10 +146,7 @@ impl LinearBipolar {
         };
         Self {
             name,
-            ends: [
-                Attachment::new(*body1, point1),
-                Attachment::new(*body2, point2),
-            ],
+            pair: TwoPoint::new(*body1, point1, *body2, point2),
             exprs: [
                 stiffness.clone(),
                 damping.clone(),
@@ -68,52 +160,12 @@ impl LinearBipolar {
         }
     }
 
-    fn deflection(&self, ctx: &ForceContext) -> Deflection {
-        let d = self.ends[1].position(ctx) - self.ends[0].position(ctx);
-        let length = d.norm();
-        if length <= f64::MIN_POSITIVE {
-            return Deflection {
-                length: 0.0,
-                rate: 0.0,
-                direction: None,
-            };
+    /// Tension F (N); zero at zero length.
+    fn force(&self, s: &PairState) -> f64 {
+        if s.direction.is_none() {
+            return 0.0;
         }
-        let e = d / length;
-        let rate = (self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx)).dot(&e);
-        Deflection {
-            length,
-            rate,
-            direction: Some(e),
-        }
-    }
-
-    fn force(&self, x: &Deflection) -> f64 {
-        self.stiffness * (x.length - self.free_length) + self.damping * x.rate + self.preload
-    }
-
-    /// Local Jacobians of the force on end 2, f₂ = −F e, with respect to
-    /// d = P₂ − P₁ and ḋ (F the tension, x = |d|, e = d/x, ẋ = e·ḋ):
-    /// ∂f₂/∂d = −[e (c e + d (E − e eᵀ) ḋ / x)ᵀ + (F/x)(E − e eᵀ)], ∂f₂/∂ḋ = −d e eᵀ.
-    /// Zero at zero length (no direction, no force).
-    pub(crate) fn local_jacobian(
-        d: &Vector3<f64>,
-        dd: &Vector3<f64>,
-        force_rate: (f64, f64),
-        force: impl Fn(f64, f64) -> f64,
-    ) -> (Matrix3<f64>, Matrix3<f64>) {
-        let x = d.norm();
-        if x <= f64::MIN_POSITIVE {
-            return (Matrix3::zeros(), Matrix3::zeros());
-        }
-        let e = d / x;
-        let rate = e.dot(dd);
-        let (c, dmp) = force_rate;
-        let f = force(x, rate);
-        let transverse = Matrix3::identity() - e * e.transpose();
-        let g = c * e + dmp * (transverse * dd) / x;
-        let kq = -(e * g.transpose() + (f / x) * transverse);
-        let kv = -dmp * e * e.transpose();
-        (kq, kv)
+        self.stiffness * (s.length - self.free_length) + self.damping * s.rate + self.preload
     }
 }
 
@@ -123,9 +175,7 @@ impl ForceElement for LinearBipolar {
     }
 
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
-        for end in &mut self.ends {
-            end.set_parameters(params, &self.name)?;
-        }
+        self.pair.set_parameters(params, &self.name)?;
         let [c, d, f0, x0] = &self.exprs;
         self.stiffness = eval_scalar(c, params, &self.name, "stiffness c")?;
         self.damping = eval_scalar(d, params, &self.name, "damping d")?;
@@ -135,15 +185,8 @@ impl ForceElement for LinearBipolar {
     }
 
     fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
-        let x = self.deflection(ctx);
-        let Some(e) = x.direction else {
-            return Ok(());
-        };
-        let f = self.force(&x) * e;
-        let p1 = self.ends[0].position(ctx);
-        let p2 = self.ends[1].position(ctx);
-        add_force(wrenches, ctx, self.ends[0].body, &p1, &f);
-        add_force(wrenches, ctx, self.ends[1].body, &p2, &(-f));
+        let s = self.pair.state(ctx);
+        self.pair.apply(ctx, &s, self.force(&s), wrenches);
         Ok(())
     }
 
@@ -152,24 +195,14 @@ impl ForceElement for LinearBipolar {
     }
 
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
-        let x = self.deflection(ctx);
-        let f = if x.direction.is_some() {
-            self.force(&x)
-        } else {
-            0.0
-        };
-        out.extend([f, x.length, x.rate]);
+        let s = self.pair.state(ctx);
+        out.extend([self.force(&s), s.length, s.rate]);
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
-        let p1 = self.ends[0].position(ctx);
-        let p2 = self.ends[1].position(ctx);
-        let dd = self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx);
-        let (kq, kv) =
-            Self::local_jacobian(&(p2 - p1), &dd, (self.stiffness, self.damping), |x, v| {
-                self.stiffness * (x - self.free_length) + self.damping * v + self.preload
-            });
-        jac.add_point_pair(self.ends[0].body, &p1, self.ends[1].body, &p2, &kq, &kv);
+        let s = self.pair.state(ctx);
+        self.pair
+            .add_jacobian(&s, self.force(&s), self.stiffness, self.damping, jac);
         Ok(())
     }
 }

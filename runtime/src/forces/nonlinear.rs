@@ -21,12 +21,11 @@
 //! over several: the step-size control sees the kink of the saturated law
 //! and shortens the steps around it.
 
-use super::{
-    Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,
-};
+use super::bipolar::TwoPoint;
+use super::{ForceContext, ForceElement, ForceJacobian, Wrench, eval_scalar};
 use crate::system::SimError;
-use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{BodyRef, Expr, ForceKind};
+
+use railmbs_models::{Expr, ForceKind};
 
 /// Velocity below which the sign of the sliding velocity is regularized
 /// linearly, m/s.
@@ -41,106 +40,6 @@ pub(crate) fn reg_sign(v: f64) -> (f64, f64) {
     } else {
         (v / V_REG, 1.0 / V_REG)
     }
-}
-
-/// Two attachment points and the kinematics of their distance.
-#[derive(Debug, Clone)]
-pub(crate) struct TwoPoint {
-    ends: [Attachment; 2],
-}
-
-/// Distance x (m), its rate (m/s), unit vector from end 1 to end 2 (None at
-/// zero length), the end positions (SC0).
-pub(crate) struct PairState {
-    pub length: f64,
-    pub rate: f64,
-    pub direction: Option<Vector3<f64>>,
-    pub p1: Vector3<f64>,
-    pub p2: Vector3<f64>,
-    pub relative_velocity: Vector3<f64>,
-}
-
-impl TwoPoint {
-    pub fn new(b1: BodyRef, p1: &[Expr; 3], b2: BodyRef, p2: &[Expr; 3]) -> Self {
-        Self {
-            ends: [Attachment::new(b1, p1), Attachment::new(b2, p2)],
-        }
-    }
-
-    pub fn set_parameters(&mut self, params: &[f64], owner: &str) -> Result<(), SimError> {
-        for e in &mut self.ends {
-            e.set_parameters(params, owner)?;
-        }
-        Ok(())
-    }
-
-    pub fn state(&self, ctx: &ForceContext) -> PairState {
-        let p1 = self.ends[0].position(ctx);
-        let p2 = self.ends[1].position(ctx);
-        let dv = self.ends[1].velocity(ctx) - self.ends[0].velocity(ctx);
-        let d = p2 - p1;
-        let length = d.norm();
-        if length <= f64::MIN_POSITIVE {
-            return PairState {
-                length: 0.0,
-                rate: 0.0,
-                direction: None,
-                p1,
-                p2,
-                relative_velocity: dv,
-            };
-        }
-        let e = d / length;
-        PairState {
-            length,
-            rate: dv.dot(&e),
-            direction: Some(e),
-            p1,
-            p2,
-            relative_velocity: dv,
-        }
-    }
-
-    /// Applies the tension `f` (N, positive pulls the ends together).
-    pub fn apply(&self, ctx: &ForceContext, s: &PairState, f: f64, wrenches: &mut [Wrench]) {
-        let Some(e) = s.direction else { return };
-        let fv = f * e;
-        add_force(wrenches, ctx, self.ends[0].body, &s.p1, &fv);
-        add_force(wrenches, ctx, self.ends[1].body, &s.p2, &(-fv));
-    }
-
-    /// Adds the Jacobian of a tension F(x, ẋ) with ∂F/∂x = `dfdx`, ∂F/∂ẋ =
-    /// `dfdv`: for f₂ = −F e, ∂f₂/∂d = −[e (F_x e + F_v (E − e eᵀ) ḋ/x)ᵀ +
-    /// (F/x)(E − e eᵀ)] and ∂f₂/∂ḋ = −F_v e eᵀ.
-    pub fn add_jacobian(
-        &self,
-        s: &PairState,
-        f: f64,
-        dfdx: f64,
-        dfdv: f64,
-        jac: &mut ForceJacobian,
-    ) {
-        let Some(e) = s.direction else { return };
-        let (kq, kv) = bipolar_jacobian(&e, s.length, &s.relative_velocity, f, dfdx, dfdv);
-        jac.add_point_pair(self.ends[0].body, &s.p1, self.ends[1].body, &s.p2, &kq, &kv);
-    }
-}
-
-/// Local Jacobians (∂f₂/∂d, ∂f₂/∂ḋ) of a bipolar tension F(x, ẋ), see
-/// [`TwoPoint::add_jacobian`].
-pub(crate) fn bipolar_jacobian(
-    e: &Vector3<f64>,
-    x: f64,
-    dd: &Vector3<f64>,
-    f: f64,
-    dfdx: f64,
-    dfdv: f64,
-) -> (Matrix3<f64>, Matrix3<f64>) {
-    let transverse = Matrix3::identity() - e * e.transpose();
-    let g = dfdx * e + dfdv * (transverse * dd) / x;
-    let kq = -(e * g.transpose() + (f / x) * transverse);
-    let kv = -dfdv * e * e.transpose();
-    (kq, kv)
 }
 
 // ---------------------------------------------------------------------------
