@@ -375,25 +375,53 @@ fn parallelogram_four_bar_moves_like_its_one_dof_equivalent() {
     let kk = g * a * (0.5 * m1 + m2 + 0.5 * m3) / ieq;
     let (mut th, mut w, h) = (th0, 0.0, 1e-4);
     let f = |th: f64| -kk * th.sin();
-    let mut ref_at = vec![(0.0, th)];
-    for i in 0..50_000 {
+    // (θ, ω) on the grid k·h of the reference integration.
+    let mut grid = vec![(th, w)];
+    for _ in 0..50_000 {
         let (k1t, k1w) = (w, f(th));
         let (k2t, k2w) = (w + 0.5 * h * k1w, f(th + 0.5 * h * k1t));
         let (k3t, k3w) = (w + 0.5 * h * k2w, f(th + 0.5 * h * k2t));
         let (k4t, k4w) = (w + h * k3w, f(th + h * k3t));
         th += h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);
         w += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
-        ref_at.push(((i + 1) as f64 * h, th));
+        grid.push((th, w));
     }
-    for (t, q, _) in steps.iter().step_by(50) {
-        let idx = (t / h).round() as usize;
-        let (tr, thr) = ref_at[idx];
-        if (tr - t).abs() < 1e-9 {
-            assert!(
-                (q[0] - thr).abs() < 1e-5,
-                "t = {t}: crank {} vs equivalent pendulum {thr}",
-                q[0]
-            );
-        }
+    // The reference at any step time: cubic Hermite between its grid points
+    // from θ and ω = θ̇ (error ~ h⁴ θ⁗ ≈ 1e-16 rad at h = 0.1 ms, far below the
+    // 1e-5 rad checked).
+    let reference = |t: f64| -> f64 {
+        let k = ((t / h).floor() as usize).min(grid.len() - 2);
+        let ((th0, w0), (th1, w1)) = (grid[k], grid[k + 1]);
+        let s = t / h - k as f64;
+        let (s2, s3) = (s * s, s * s * s);
+        (2.0 * s3 - 3.0 * s2 + 1.0) * th0
+            + (s3 - 2.0 * s2 + s) * h * w0
+            + (-2.0 * s3 + 3.0 * s2) * th1
+            + (s3 - s2) * h * w1
+    };
+    // The crank angle converges to the equivalent pendulum at Park's order 2
+    // (fixed steps; measured 5.9e-6, 1.5e-6, 3.7e-7 rad over 5 s). Every step
+    // state is compared.
+    let errors: Vec<f64> = [4e-4, 2e-4, 1e-4]
+        .iter()
+        .map(|&hp| {
+            let (mut s, q0, v0) = numeric_system(&model, &[]);
+            let (st, _) = run_park(&mut s, &ParkSettings::fixed(hp), &q0, &v0, 5.0);
+            assert!(st.len() > 10_000);
+            st.iter()
+                .map(|(t, q, _)| (q[0] - reference(*t)).abs())
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    assert!(
+        errors[2] < 1e-6,
+        "crank vs equivalent pendulum: {errors:?} rad"
+    );
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!(
+            (1.8..2.2).contains(&order),
+            "errors {errors:?} fall with order {order}"
+        );
     }
 }
