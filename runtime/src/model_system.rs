@@ -22,6 +22,8 @@ pub struct ModelSystem {
     /// initial state.
     forces_initialized: bool,
     recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
+    /// Zeros, the velocity argument of constraint evaluations.
+    zero_velocity: Vec<f64>,
 }
 
 impl std::fmt::Debug for ModelSystem {
@@ -89,6 +91,7 @@ impl ModelSystem {
             jacobian_scratch: JacobianScratch::new(model.coordinates.len()),
             forces_initialized: false,
             recorder: None,
+            zero_velocity: Vec::new(),
         })
     }
 
@@ -215,7 +218,8 @@ impl MechanicalSystem for ModelSystem {
         g: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
     ) -> Result<(), SimError> {
-        let v = vec![0.0; q.len()];
+        // Constraints depend on q only; reuse a zero velocity vector.
+        self.zero_velocity.resize(q.len(), 0.0);
         let parts = Parts {
             mass: false,
             bias: false,
@@ -224,7 +228,8 @@ impl MechanicalSystem for ModelSystem {
             jacobians: false,
             constraints: true,
         };
-        self.equations.evaluate(t, q, &v, parts, &mut self.eval)?;
+        self.equations
+            .evaluate(t, q, &self.zero_velocity, parts, &mut self.eval)?;
         g.copy_from(&self.eval.constraints);
         jacobian.copy_from(&self.eval.constraint_jacobian);
         Ok(())
