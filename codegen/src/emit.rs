@@ -300,6 +300,11 @@ fn emit_unit(
         }
     }
     let (nq, np, nu) = (n, n_params, 3 * n_inputs);
+    let loaded_later: std::collections::HashSet<u32> = split
+        .chunks
+        .iter()
+        .flat_map(|c| c.loads.iter().map(|&(t, _)| t))
+        .collect();
     for (ci, chunk) in split.chunks.iter().enumerate() {
         let fname = format_ident!("{}_{}", unit.name, ci);
         let local = |k: u32| {
@@ -328,11 +333,17 @@ fn emit_unit(
                 let e = instr(&prog.instrs[k], &local);
                 quote!(let #id = #e;)
             });
-        let stores = chunk.stores.iter().map(|&(t, s)| {
-            let id = format_ident!("t{}", t);
-            let s = s as usize;
-            quote!(s[#s] = #id;)
-        });
+        // Outputs are written to their buffers by the chunk that defines them:
+        // only temporaries a later chunk loads go through the scratch array.
+        let stores = chunk
+            .stores
+            .iter()
+            .filter(|(t, _)| loaded_later.contains(t))
+            .map(|&(t, s)| {
+                let id = format_ident!("t{}", t);
+                let s = s as usize;
+                quote!(s[#s] = #id;)
+            });
         let mut buffers = std::collections::BTreeSet::new();
         let writes: Vec<TokenStream> = writes_in_chunk[ci]
             .iter()
