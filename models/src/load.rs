@@ -7,7 +7,7 @@ use crate::model::*;
 use crate::parser::{ParseErrorKind, is_identifier, is_reserved_name, parse_expr};
 use crate::raw::*;
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Reads and resolves a model file. All problems found are returned together.
 pub fn load_model(path: &Path) -> Result<Model, ModelErrors> {
@@ -65,6 +65,7 @@ const FORCE: &[&str] = &[
     "Coulomb",
     "LoadFriction",
     "Tabulated",
+    "WheelRail",
 ];
 
 fn kind_of(ctor: &str) -> &'static str {
@@ -72,7 +73,7 @@ fn kind_of(ctor: &str) -> &'static str {
         "Body" => "body",
         "CutJoint" => "cut joint",
         "Spring" | "Linear6" | "Applied" | "PointPlane" | "Coulomb" | "LoadFriction"
-        | "Tabulated" => "force",
+        | "Tabulated" | "WheelRail" => "force",
         "Scenario" => "scenario",
         "Model" => "model",
         _ => "element",
@@ -1325,6 +1326,48 @@ impl Cx<'_> {
                         free_length: self.expr(&w, "x0", "x0", x0, false),
                     }
                 }
+                RawForce::WheelRail {
+                    wheelset,
+                    wheel_profile,
+                    wheel_profile_right,
+                    rail_profile,
+                    rail_profile_right,
+                    radius,
+                    flange_back_distance,
+                    taping_offset,
+                    mu,
+                    young,
+                    poisson,
+                    normal_damping,
+                    creep,
+                    rail,
+                    table,
+                    ..
+                } => self.wheel_rail(
+                    &w,
+                    lookup,
+                    WheelRailRaw {
+                        wheelset,
+                        profiles: [
+                            ("wheel_profile", Some(wheel_profile)),
+                            ("wheel_profile_right", wheel_profile_right.as_ref()),
+                            ("rail_profile", Some(rail_profile)),
+                            ("rail_profile_right", rail_profile_right.as_ref()),
+                        ],
+                        values: [
+                            ("radius", radius),
+                            ("flange_back_distance", flange_back_distance),
+                            ("taping_offset", taping_offset),
+                            ("mu", mu),
+                            ("young", young),
+                            ("poisson", poisson),
+                            ("normal_damping", normal_damping),
+                        ],
+                        creep,
+                        rail,
+                        table,
+                    },
+                ),
                 RawForce::Applied {
                     body,
                     point,
@@ -1365,6 +1408,168 @@ impl Cx<'_> {
             });
         }
         out
+    }
+}
+
+/// The fields of a raw `WheelRail` element, borrowed for resolution.
+struct WheelRailRaw<'r> {
+    wheelset: &'r str,
+    /// (key, path text): wheel left/right, rail left/right.
+    profiles: [(&'static str, Option<&'r String>); 4],
+    /// (key, value): radius, flange_back_distance, taping_offset, mu, young,
+    /// poisson, normal_damping.
+    values: [(&'static str, &'r Value); 7],
+    creep: &'r RawCreepLaw,
+    rail: &'r RawRail,
+    table: &'r RawTable,
+}
+
+impl Cx<'_> {
+    /// Resolves a wheel–rail element: the wheelset body, profile files (paths
+    /// relative to the model file, which must exist), material and friction
+    /// values (checked with the defaults), the creep law, rails and table grid.
+    fn wheel_rail(&mut self, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> ForceKind {
+        let wheelset = match self.body_ref(w, "wheelset", raw.wheelset, lookup) {
+            BodyRef::Body(k) => k,
+            BodyRef::Ground => {
+                if raw.wheelset == "ground" {
+                    self.err(
+                        w,
+                        Some("wheelset"),
+                        None,
+                        "the wheelset must be a body, not ground".into(),
+                    );
+                }
+                0
+            }
+        };
+        let base = self.file.parent().unwrap_or(Path::new("."));
+        let mut paths: Vec<PathBuf> = Vec::with_capacity(4);
+        for (k, (key, text)) in raw.profiles.iter().enumerate() {
+            // A missing right-hand profile is the left one (mirrored when placed).
+            let Some(text) = text.or(raw.profiles[k - k % 2].1) else {
+                paths.push(PathBuf::new());
+                continue;
+            };
+            let path = base.join(text);
+            if text.is_empty() || !path.is_file() {
+                self.err(
+                    w,
+                    Some(key),
+                    Some(text),
+                    format!("profile file not found: {}", path.display()),
+                );
+            }
+            paths.push(path);
+        }
+        let e: Vec<Expr> = raw
+            .values
+            .iter()
+            .map(|(key, v)| self.expr(w, key, key, v, false))
+            .collect();
+        for (k, key) in ["radius", "flange_back_distance", "young"]
+            .iter()
+            .enumerate()
+        {
+            let idx = [0, 1, 4][k];
+            self.check_positive(w, key, &e[idx]);
+        }
+        for (idx, key) in [(2, "taping_offset"), (3, "mu"), (6, "normal_damping")] {
+            self.check_non_negative(w, key, &e[idx]);
+        }
+        if let Some(d) = &self.defaults {
+            let nu = e[5].eval(d, 0.0);
+            if nu.is_finite() && !(0.0..=0.5).contains(&nu) {
+                self.err(
+                    w,
+                    Some("poisson"),
+                    None,
+                    format!("poisson must be in [0, 0.5], got {nu}"),
+                );
+            }
+        }
+        let creep = match raw.creep {
+            RawCreepLaw::Kalker => CreepLawKind::Kalker,
+            RawCreepLaw::Mueller { exponent } => {
+                let exponent = self.expr(w, "creep.exponent", "exponent", exponent, false);
+                self.check_positive(w, "exponent", &exponent);
+                CreepLawKind::Mueller { exponent }
+            }
+            RawCreepLaw::Fastsim { nx, ny } => {
+                if *nx == 0 || *ny == 0 {
+                    self.err(
+                        w,
+                        Some("creep"),
+                        None,
+                        format!("FASTSIM needs at least one element each way, got {nx} × {ny}"),
+                    );
+                }
+                CreepLawKind::Fastsim { nx: *nx, ny: *ny }
+            }
+            RawCreepLaw::FastsimA { strips } => {
+                if *strips == 0 {
+                    self.err(
+                        w,
+                        Some("creep"),
+                        None,
+                        "FastSim_A needs at least one strip".into(),
+                    );
+                }
+                CreepLawKind::FastsimA { strips: *strips }
+            }
+        };
+        let rail = match raw.rail {
+            RawRail::Rigid => RailKind::Rigid,
+            RawRail::Elastic { ky, cy, kz, cz } => {
+                let ky = self.expr(w, "rail.ky", "ky", ky, false);
+                let cy = self.expr(w, "rail.cy", "cy", cy, false);
+                let kz = self.expr(w, "rail.kz", "kz", kz, false);
+                let cz = self.expr(w, "rail.cz", "cz", cz, false);
+                self.check_positive(w, "ky", &ky);
+                self.check_positive(w, "kz", &kz);
+                self.check_non_negative(w, "cy", &cy);
+                self.check_non_negative(w, "cz", &cz);
+                RailKind::Elastic { ky, cy, kz, cz }
+            }
+        };
+        let t = raw.table;
+        for (key, v, zero_ok) in [
+            ("y_max", t.y_max, false),
+            ("dy", t.dy, false),
+            ("roll_max", t.roll_max, true),
+            ("droll", t.droll, false),
+        ] {
+            if !(v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0))) {
+                self.err(
+                    w,
+                    Some(key),
+                    None,
+                    format!("table {key} must be positive and finite, got {v}"),
+                );
+            }
+        }
+        let mut e = e.into_iter();
+        let mut next = || e.next().expect("seven values");
+        ForceKind::WheelRail(Box::new(WheelRail {
+            wheelset,
+            wheel_profiles: [paths[0].clone(), paths[1].clone()],
+            rail_profiles: [paths[2].clone(), paths[3].clone()],
+            radius: next(),
+            flange_back_distance: next(),
+            taping_offset: next(),
+            mu: next(),
+            young: next(),
+            poisson: next(),
+            normal_damping: next(),
+            creep,
+            rail,
+            table: ContactTableSpec {
+                y_max: t.y_max,
+                dy: t.dy,
+                roll_max: t.roll_max,
+                droll: t.droll,
+            },
+        }))
     }
 }
 

@@ -265,6 +265,14 @@ pub enum ForceKind {
         /// m.
         free_length: Expr,
     },
+    /// Wheel–rail contact of a wheelset on the scenario's track (seed paper
+    /// Sect. 4): left and right wheel against their rails, contact geometry
+    /// from a table over lateral shift and roll, Hertzian normal force, creep
+    /// forces by the chosen law. The wheelset body's frame has its origin at
+    /// the axle centre and its y axis along the axle (to the left); its spin
+    /// about y may be a coordinate or not (then the wheels' rolling speed is
+    /// that of the body's angular velocity anyway).
+    WheelRail(Box<WheelRail>),
     /// An applied force and torque on one body; expressions may depend on `t`.
     Applied {
         body: usize,
@@ -276,6 +284,77 @@ pub enum ForceKind {
         torque: [Expr; 3],
         frame: VectorFrame,
     },
+}
+
+/// Data of a wheel–rail contact element ([`ForceKind::WheelRail`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WheelRail {
+    /// The wheelset body.
+    pub wheelset: usize,
+    /// Wheel profiles (left, right; the right one mirrored when placed),
+    /// absolute paths.
+    pub wheel_profiles: [PathBuf; 2],
+    /// Rail profiles (left, right), absolute paths. The track's rail
+    /// inclination is applied when they are read.
+    pub rail_profiles: [PathBuf; 2],
+    /// Nominal rolling radius at the taping line, m.
+    pub radius: Expr,
+    /// Distance between the flange backs, m.
+    pub flange_back_distance: Expr,
+    /// Distance from a flange back to the taping line, m.
+    pub taping_offset: Expr,
+    /// Coefficient of friction, –.
+    pub mu: Expr,
+    /// Young's modulus of wheel and rail, Pa.
+    pub young: Expr,
+    /// Poisson's ratio of wheel and rail, –.
+    pub poisson: Expr,
+    /// Damping along the contact normal, N s/m (0: none).
+    pub normal_damping: Expr,
+    /// The creep-force law.
+    pub creep: CreepLawKind,
+    /// Rigid rails, or massless elastic rails (seed paper Sect. 4.2).
+    pub rail: RailKind,
+    /// Contact table ranges and steps.
+    pub table: ContactTableSpec,
+}
+
+/// Creep-force law of a wheel–rail element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CreepLawKind {
+    /// Kalker's linear theory (no saturation).
+    Kalker,
+    /// Linear theory saturated towards μN (exponent n, Mueller et al.).
+    Mueller { exponent: Expr },
+    /// Kalker's FASTSIM with `nx` × `ny` elements.
+    Fastsim { nx: usize, ny: usize },
+    /// Pogorelov's semi-analytic FastSim_A with `strips` strips.
+    FastsimA { strips: usize },
+}
+
+/// The rails of a wheel–rail element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RailKind {
+    /// Rails fixed to the track.
+    Rigid,
+    /// Massless rail heads on lateral and vertical spring–dampers (per rail):
+    /// N/m, N s/m.
+    Elastic {
+        ky: Expr,
+        cy: Expr,
+        kz: Expr,
+        cz: Expr,
+    },
+}
+
+/// Contact table grid: lateral shift in [−y_max, y_max] by dy, roll in
+/// [−roll_max, roll_max] by droll (m, rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactTableSpec {
+    pub y_max: f64,
+    pub dy: f64,
+    pub roll_max: f64,
+    pub droll: f64,
 }
 
 /// A named force element.

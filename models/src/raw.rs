@@ -506,6 +506,35 @@ pub(crate) enum RawForce {
         #[serde(default)]
         x0: Value,
     },
+    WheelRail {
+        name: String,
+        wheelset: String,
+        wheel_profile: String,
+        #[serde(default)]
+        wheel_profile_right: Option<String>,
+        rail_profile: String,
+        #[serde(default)]
+        rail_profile_right: Option<String>,
+        radius: Value,
+        #[serde(default = "default_back_to_back")]
+        flange_back_distance: Value,
+        #[serde(default = "default_taping_offset")]
+        taping_offset: Value,
+        #[serde(default = "default_mu")]
+        mu: Value,
+        #[serde(default = "default_young")]
+        young: Value,
+        #[serde(default = "default_poisson")]
+        poisson: Value,
+        #[serde(default)]
+        normal_damping: Value,
+        #[serde(default)]
+        creep: RawCreepLaw,
+        #[serde(default)]
+        rail: RawRail,
+        #[serde(default)]
+        table: RawTable,
+    },
     Applied {
         name: String,
         body: String,
@@ -529,7 +558,113 @@ impl RawForce {
             | RawForce::PointPlane { name, .. }
             | RawForce::Coulomb { name, .. }
             | RawForce::LoadFriction { name, .. }
-            | RawForce::Tabulated { name, .. } => name,
+            | RawForce::Tabulated { name, .. }
+            | RawForce::WheelRail { name, .. } => name,
         }
     }
+}
+
+fn default_back_to_back() -> Value {
+    Value::Num(1.360)
+}
+
+fn default_taping_offset() -> Value {
+    Value::Num(0.070)
+}
+
+fn default_mu() -> Value {
+    Value::Num(0.4)
+}
+
+fn default_young() -> Value {
+    Value::Num(2.1e11)
+}
+
+fn default_poisson() -> Value {
+    Value::Num(0.28)
+}
+
+/// Creep-force law of a `WheelRail` element.
+#[derive(Debug, Deserialize)]
+#[serde(rename = "CreepLaw")]
+pub(crate) enum RawCreepLaw {
+    Kalker,
+    Mueller {
+        #[serde(default = "default_mueller_exponent")]
+        exponent: Value,
+    },
+    Fastsim {
+        nx: usize,
+        ny: usize,
+    },
+    FastsimA {
+        strips: usize,
+    },
+}
+
+impl Default for RawCreepLaw {
+    fn default() -> Self {
+        RawCreepLaw::FastsimA { strips: 20 }
+    }
+}
+
+fn default_mueller_exponent() -> Value {
+    Value::Num(2.0)
+}
+
+/// Rails of a `WheelRail` element.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename = "Rail")]
+pub(crate) enum RawRail {
+    #[default]
+    Rigid,
+    Elastic {
+        ky: Value,
+        #[serde(default)]
+        cy: Value,
+        kz: Value,
+        #[serde(default)]
+        cz: Value,
+    },
+}
+
+/// Contact table grid of a `WheelRail` element (m, rad).
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Table", deny_unknown_fields)]
+pub(crate) struct RawTable {
+    #[serde(default = "default_table_y_max")]
+    pub y_max: f64,
+    #[serde(default = "default_table_dy")]
+    pub dy: f64,
+    #[serde(default = "default_table_roll_max")]
+    pub roll_max: f64,
+    #[serde(default = "default_table_droll")]
+    pub droll: f64,
+}
+
+impl Default for RawTable {
+    fn default() -> Self {
+        RawTable {
+            y_max: default_table_y_max(),
+            dy: default_table_dy(),
+            roll_max: default_table_roll_max(),
+            droll: default_table_droll(),
+        }
+    }
+}
+
+fn default_table_y_max() -> f64 {
+    0.025
+}
+
+fn default_table_dy() -> f64 {
+    0.1e-3
+}
+
+fn default_table_roll_max() -> f64 {
+    0.03
+}
+
+fn default_table_droll() -> f64 {
+    2e-3
 }
