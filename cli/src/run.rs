@@ -107,6 +107,36 @@ fn summary_text(s: &RunSummary, output: Option<&std::path::Path>) -> String {
             1e6 * s.cpu_time / s.steps as f64
         );
     }
+    if !s.assessment.is_empty() {
+        say!("");
+        say!(
+            "{:<28} {:<12} {:>12} {:>9} {:>12} {:<11} {:>6}",
+            "element",
+            "quantity",
+            "max",
+            "at t [s]",
+            "limit",
+            "",
+            "ratio"
+        );
+        for a in &s.assessment {
+            let (limit, ratio) = match a.limit {
+                Some(l) => (format!("{l:.4}"), format!("{:.2}", a.max / l)),
+                None => (String::new(), String::new()),
+            };
+            say!(
+                "{:<28} {:<12} {:>12.4} {:>9.3} {:>12} {:<11} {:>6}",
+                a.element,
+                format!("{} [{}]", a.quantity, a.unit),
+                a.max,
+                a.time,
+                limit,
+                a.limit_name,
+                ratio
+            );
+        }
+        say!("");
+    }
     match output {
         Some(p) => say!("output                 {} ({} rows)", p.display(), s.rows),
         None => {

@@ -700,6 +700,38 @@ impl Cx<'_> {
         });
     }
 
+    /// Starts the joint of `jb` with a track-following frame at arc offset
+    /// `offset` (six input transformations: x, y, z, yaw, pitch, roll).
+    fn track_frame(&mut self, w: &Where, jb: &mut JointBuilder, parent: &str, offset: &Value) {
+        if parent != "ground" {
+            self.err(
+                        w,
+                        Some("track"),
+                        None,
+                        format!(
+                            "a track-following frame moves relative to SC0: the parent must be \"ground\", not \"{parent}\""
+                        ),
+                    );
+        }
+        let e = self.expr(w, "track offset", "track", offset, false);
+        self.track_offsets.insert(jb.body_name.to_string(), e);
+        // Pose of the frame: x, y, z, then yaw (z), pitch (y), roll (x).
+        let kinds = [
+            ElementaryKind::Translation(Axis::X),
+            ElementaryKind::Translation(Axis::Y),
+            ElementaryKind::Translation(Axis::Z),
+            ElementaryKind::Rotation(Axis::Z),
+            ElementaryKind::Rotation(Axis::Y),
+            ElementaryKind::Rotation(Axis::X),
+        ];
+        for (component, kind) in kinds.into_iter().enumerate() {
+            jb.joint.push(Elementary {
+                kind,
+                motion: Motion::Input(component),
+            });
+        }
+    }
+
     fn expand_joint(&mut self, w: &Where, joint: &RawJoint, jb: &mut JointBuilder) {
         match joint {
             RawJoint::Revolute {
@@ -744,33 +776,7 @@ impl Cx<'_> {
                 track,
             } => {
                 if let Some(offset) = track {
-                    if parent != "ground" {
-                        self.err(
-                            w,
-                            Some("track"),
-                            None,
-                            format!(
-                                "a track-following frame moves relative to SC0: the parent must be \"ground\", not \"{parent}\""
-                            ),
-                        );
-                    }
-                    let e = self.expr(w, "track offset", "track", offset, false);
-                    self.track_offsets.insert(jb.body_name.to_string(), e);
-                    // Pose of the frame: x, y, z, then yaw (z), pitch (y), roll (x).
-                    let kinds = [
-                        ElementaryKind::Translation(Axis::X),
-                        ElementaryKind::Translation(Axis::Y),
-                        ElementaryKind::Translation(Axis::Z),
-                        ElementaryKind::Rotation(Axis::Z),
-                        ElementaryKind::Rotation(Axis::Y),
-                        ElementaryKind::Rotation(Axis::X),
-                    ];
-                    for (component, kind) in kinds.into_iter().enumerate() {
-                        jb.joint.push(Elementary {
-                            kind,
-                            motion: Motion::Input(component),
-                        });
-                    }
+                    self.track_frame(w, jb, parent, offset);
                 }
                 self.fixed3(w, jb, true, "at", at);
                 let inits = [&init.0, &init.1, &init.2, &init.3, &init.4, &init.5];
@@ -827,7 +833,15 @@ impl Cx<'_> {
                     );
                 }
             }
-            RawJoint::Rigid { at, rotation, .. } => {
+            RawJoint::Rigid {
+                parent,
+                at,
+                rotation,
+                track,
+            } => {
+                if let Some(offset) = track {
+                    self.track_frame(w, jb, parent, offset);
+                }
                 self.fixed3(w, jb, true, "at", at);
                 self.fixed3(w, jb, false, "rotation", rotation);
             }
@@ -1332,6 +1346,7 @@ impl Cx<'_> {
                     wheel_profile_right,
                     rail_profile,
                     rail_profile_right,
+                    rail_profile_inclined,
                     radius,
                     flange_back_distance,
                     taping_offset,
@@ -1363,6 +1378,7 @@ impl Cx<'_> {
                             ("poisson", poisson),
                             ("normal_damping", normal_damping),
                         ],
+                        rail_profile_inclined: *rail_profile_inclined,
                         creep,
                         rail,
                         table,
@@ -1419,6 +1435,7 @@ struct WheelRailRaw<'r> {
     /// (key, value): radius, flange_back_distance, taping_offset, mu, young,
     /// poisson, normal_damping.
     values: [(&'static str, &'r Value); 7],
+    rail_profile_inclined: bool,
     creep: &'r RawCreepLaw,
     rail: &'r RawRail,
     table: &'r RawTable,
@@ -1554,6 +1571,7 @@ impl Cx<'_> {
             wheelset,
             wheel_profiles: [paths[0].clone(), paths[1].clone()],
             rail_profiles: [paths[2].clone(), paths[3].clone()],
+            rail_profiles_inclined: raw.rail_profile_inclined,
             radius: next(),
             flange_back_distance: next(),
             taping_offset: next(),

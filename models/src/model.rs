@@ -295,8 +295,13 @@ pub struct WheelRail {
     /// absolute paths.
     pub wheel_profiles: [PathBuf; 2],
     /// Rail profiles (left, right), absolute paths. The track's rail
-    /// inclination is applied when they are read.
+    /// inclination is applied when they are read, unless
+    /// `rail_profiles_inclined`.
     pub rail_profiles: [PathBuf; 2],
+    /// The rail profile files are already drawn inclined (as the Manchester
+    /// benchmark's UIC60 files are): the track's rail inclination is not
+    /// applied again.
+    pub rail_profiles_inclined: bool,
     /// Nominal rolling radius at the taping line, m.
     pub radius: Expr,
     /// Distance between the flange backs, m.

@@ -268,6 +268,9 @@ pub(crate) enum RawJoint {
         at: Vec3,
         #[serde(default = "zero3")]
         rotation: Vec3,
+        /// Fix the body to a track-following frame at this arc offset (m).
+        #[serde(default)]
+        track: Option<Value>,
     },
     Joint {
         parent: String,
@@ -515,6 +518,8 @@ pub(crate) enum RawForce {
         rail_profile: String,
         #[serde(default)]
         rail_profile_right: Option<String>,
+        #[serde(default)]
+        rail_profile_inclined: bool,
         radius: Value,
         #[serde(default = "default_back_to_back")]
         flange_back_distance: Value,

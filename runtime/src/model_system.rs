@@ -104,6 +104,20 @@ impl ModelSystem {
         self.recorder = recorder;
     }
 
+    /// Connects the force elements that need the track (wheel–rail contact)
+    /// to the scenario's track.
+    pub fn bind_track(&mut self, binding: &forces::TrackBinding) -> Result<(), SimError> {
+        for f in &mut self.forces {
+            f.bind_track(binding)?;
+        }
+        Ok(())
+    }
+
+    /// Assessment maxima of all force elements (end-of-run summary).
+    pub fn assessment(&self) -> Vec<forces::Assessment> {
+        self.forces.iter().flat_map(|f| f.assessment()).collect()
+    }
+
     /// The engine.
     pub fn equations(&self) -> &dyn Equations {
         self.equations.as_ref()

@@ -5,6 +5,7 @@
 
 use crate::Equations;
 use crate::equations::Parts;
+use crate::forces::TrackBinding;
 use crate::inputs::{DrivenEquations, InputProvider};
 use crate::integrate::{self, IntegrationStats, ParkSettings, Rk4Settings};
 use crate::model_system::ModelSystem;
@@ -49,6 +50,9 @@ pub struct RunSummary {
     /// Set when the simulation stopped with an error; rows up to that point
     /// were written.
     pub error: Option<SimError>,
+    /// Maxima of the assessment quantities (Y/Q, ΣY, Q…) over the accepted
+    /// steps, with their limits.
+    pub assessment: Vec<crate::forces::Assessment>,
 }
 
 impl RunSummary {
@@ -203,6 +207,11 @@ pub fn xyz_angles(a: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(x, b, z)
 }
 
+/// An engine driven along the track: the wrapped equations, the times at
+/// which the frames pass kinks of the track, and the track for the force
+/// elements that need it.
+type DrivenModel = (Box<dyn Equations>, Vec<f64>, Option<TrackBinding>);
+
 /// Wraps the engine of a model with track-following frames so that the
 /// scenario's track drives them; other models pass through.
 fn drive_track_frames(
@@ -210,9 +219,9 @@ fn drive_track_frames(
     model: &Model,
     params: &[f64],
     equations: Box<dyn Equations>,
-) -> Result<(Box<dyn Equations>, Vec<f64>), RunError> {
+) -> Result<DrivenModel, RunError> {
     if model.track_frames.is_empty() {
-        return Ok((equations, Vec::new()));
+        return Ok((equations, Vec::new(), None));
     }
     let setup = |message: String| RunError::Setup {
         file: scenario.source.clone(),
@@ -242,11 +251,31 @@ fn drive_track_frames(
     })?;
     let speed = railmbs_track::ConstantSpeed::new(spec.start, spec.speed)
         .map_err(|e| setup(format!("track: {e}")))?;
-    let inputs = TrackInputs::for_model(model, params, std::sync::Arc::new(track), speed)?;
+    let track = std::sync::Arc::new(track);
+    let inputs = TrackInputs::for_model(model, params, track.clone(), speed)?;
     let breakpoints = inputs.breakpoints(0.0, scenario.end_time);
+    // Each body's track frame: its own or its nearest ancestor's.
+    let mut body_offsets: Vec<Option<f64>> = vec![None; model.bodies.len()];
+    for (b, body) in model.bodies.iter().enumerate() {
+        body_offsets[b] = match body.parent {
+            railmbs_models::BodyRef::Body(p) => body_offsets[p],
+            railmbs_models::BodyRef::Ground => None,
+        };
+        if let Some(k) = model.track_frames.iter().position(|f| f.body == b) {
+            body_offsets[b] = Some(inputs.offsets()[k]);
+        }
+    }
+    let binding = TrackBinding {
+        track,
+        s0: spec.start,
+        speed: spec.speed,
+        body_offsets,
+        tables: Default::default(),
+    };
     Ok((
         Box::new(DrivenEquations::new(equations, Box::new(inputs))?),
         breakpoints,
+        Some(binding),
     ))
 }
 
@@ -453,8 +482,24 @@ pub fn run_scenario(
         v: v0,
     } = scenario_state(scenario, model)?;
     let engine = equations.engine_name().to_string();
-    let (equations, breakpoints) = drive_track_frames(scenario, model, &params, equations)?;
+    let (equations, breakpoints, binding) =
+        drive_track_frames(scenario, model, &params, equations)?;
     let mut system = ModelSystem::new(model, equations, params)?;
+    match &binding {
+        Some(b) => system.bind_track(b)?,
+        None => {
+            if let Some(f) = system.forces().iter().find(|f| f.needs_track()) {
+                return Err(RunError::Setup {
+                    file: scenario.source.clone(),
+                    message: format!(
+                        "force element \"{}\" needs a track: put its wheelset on a \
+                         track-following frame and give the scenario a `track`",
+                        f.name()
+                    ),
+                });
+            }
+        }
+    }
     let columns = columns(model, &system, &scenario.output, &scenario.source)?;
     let writer = match output {
         Some(p) => {
@@ -561,6 +606,7 @@ pub fn run_scenario(
         cpu_time: 0.0,
         rows: 0,
         error: None,
+        assessment: Vec::new(),
     };
     let (mut t0, mut q, mut v) = (0.0, q0.clone(), v0.clone());
     for (k, &breakpoint) in breakpoints.iter().chain([&t_end]).enumerate() {
@@ -619,5 +665,6 @@ pub fn run_scenario(
     }
     summary.cpu_time = cpu_time;
     summary.rows = rec.rows;
+    summary.assessment = system.assessment();
     Ok(summary)
 }

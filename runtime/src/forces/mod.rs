@@ -10,12 +10,14 @@ mod bipolar;
 pub mod contact;
 mod linear6;
 pub mod nonlinear;
+pub mod wheel_rail;
 
 pub use applied::AppliedForce;
 pub use bipolar::LinearBipolar;
 pub use contact::{PointPlane, contact_stiffness_damping};
 pub use linear6::Linear6;
 pub use nonlinear::{CoulombFriction, LoadFriction, Tabulated};
+pub use wheel_rail::{TrackBinding, WheelRailContact};
 
 use crate::equations::BodyKinematics;
 use crate::system::SimError;
@@ -30,6 +32,26 @@ use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model};
 pub struct Wrench {
     pub force: Vector3<f64>,
     pub moment: Vector3<f64>,
+}
+
+/// One row of the end-of-run assessment table: the largest value of a
+/// quantity over the run, when it occurred, and its limit if there is one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assessment {
+    /// Long name of the element.
+    pub element: String,
+    /// What is measured (e.g. `Y/Q left`).
+    pub quantity: String,
+    /// Largest value over the accepted steps.
+    pub max: f64,
+    /// Time of the largest value, s.
+    pub time: f64,
+    /// The limit it is judged against, same unit.
+    pub limit: Option<f64>,
+    /// Name of the limit (e.g. `Nadal`).
+    pub limit_name: &'static str,
+    /// Unit of `max` and `limit`.
+    pub unit: &'static str,
 }
 
 /// What a force element sees: time, body kinematics (model order), parameters.
@@ -57,6 +79,21 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>);
     /// Called once per accepted step (elements with state update here only).
     fn accept_step(&mut self, _ctx: &ForceContext) {}
+    /// Connects the element to the scenario's track (wheel–rail contact);
+    /// elements that do not need the track ignore it.
+    fn bind_track(&mut self, _binding: &TrackBinding) -> Result<(), SimError> {
+        Ok(())
+    }
+    /// Whether the element cannot work without a track (see
+    /// [`ForceElement::bind_track`]).
+    fn needs_track(&self) -> bool {
+        false
+    }
+    /// Safety and loading maxima over the accepted steps so far, for the
+    /// end-of-run summary.
+    fn assessment(&self) -> Vec<Assessment> {
+        Vec::new()
+    }
     /// Adds the element's approximate contribution to ∂Q/∂q and ∂Q/∂q̇ (paper
     /// Sect. 6, Eq. 31): its local stiffness and damping matrices mapped by the
     /// Jacobians of its attachment points, neglecting the derivatives of the
@@ -374,6 +411,7 @@ pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
                 ForceKind::Coulomb { .. } => Box::new(CoulombFriction::new(name, &f.kind)),
                 ForceKind::LoadFriction { .. } => Box::new(LoadFriction::new(name, &f.kind)),
                 ForceKind::Tabulated { .. } => Box::new(Tabulated::new(name, &f.kind)),
+                ForceKind::WheelRail(spec) => Box::new(WheelRailContact::new(name, spec)),
             }
         })
         .collect()

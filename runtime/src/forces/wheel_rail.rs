@@ -1,0 +1,798 @@
+//! Wheel–rail contact of one wheelset on the scenario's track (seed paper
+//! Sect. 4; DESIGN.md "Wheel–rail contact").
+//!
+//! Per evaluation, for a wheelset body whose track-following frame sits at arc
+//! position s:
+//!
+//! 1. the wheelset's pose relative to the design track frame at s: lateral
+//!    shift y, height z, yaw ψ (of the axle about the frame's z) and roll φ
+//!    (positive lifts the left wheel); the spin never enters;
+//! 2. the rails' deviations at s (irregularities, gauge widening): each rail is
+//!    shifted rigidly, laterally by Δyₖ and vertically by Δzₖ, so wheel k sees
+//!    the wheelset at lateral shift y − Δyₖ over a nominal rail and its gap
+//!    grows by z − r₀ − Δzₖ;
+//! 3. the contacts of each wheel from the contact table (one- or two-point
+//!    contact, [`railmbs_wheelrail::geometry`]): vertical penetration p = −gap,
+//!    normal approach δ = p cos δ_c (δ_c the contact angle), Hertzian normal
+//!    force N = (δ/δ₁)^{3/2} (plus optional damping along the normal, never
+//!    pulling);
+//! 4. the contact frame: normal n in the track's cross-section plane tilted
+//!    by δ_c towards the track centre, rolling direction eₓ = a × n (a the axle
+//!    direction), eᵧ = n × eₓ; creepages from the material velocity of the
+//!    wheel at the contact point (the rails are at rest) divided by the rolling
+//!    speed V = |v·eₓ| of the wheelset centre;
+//! 5. the Hertz ellipse and the creep forces by the chosen law; on the wheel:
+//!    N n + Fx eₓ + Fy eᵧ at the contact point and the spin moment Mz n.
+//!
+//! The rails' reactions go to ground (the track is not a body of the model).
+//! Outputs per wheel follow the usual assessment conventions: Q the vertical
+//! wheel load and Y the lateral force of the wheel on the rail, positive
+//! towards the field side, both in the track frame; ΣY the track-shifting force
+//! of the wheelset (lateral force on the track, positive to the left).
+
+use super::{
+    ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment, eval_scalar,
+};
+use crate::system::SimError;
+use nalgebra::{Matrix3, Vector3};
+use railmbs_models::{CreepLawKind, RailKind, WheelRail};
+use railmbs_track::Track;
+use railmbs_wheelrail::creep::{
+    ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+};
+use railmbs_wheelrail::geometry::{
+    self, Contact, ContactSet, ContactTable, SearchSettings, TableSettings,
+};
+use railmbs_wheelrail::hertz::{HertzShape, effective_modulus, wheel_rail_curvatures};
+use railmbs_wheelrail::kalker::KalkerCoefficients;
+use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// Below this wheelset speed (m/s) the creepages are divided by it instead of
+/// the actual speed (creepages are undefined at standstill); the creep forces
+/// then act as a stiff viscous regularisation of friction.
+pub const MIN_ROLLING_SPEED: f64 = 0.1;
+
+/// The transverse relative curvature B is kept at least A/25 (axis ratio
+/// ≤ 25): conformal contact in a worn wheel throat would otherwise give B ≤ 0,
+/// where Hertz's theory does not apply.
+const MIN_CURVATURE_RATIO: f64 = 1.0 / 25.0;
+
+/// The scenario's track, as the wheel–rail elements see it.
+pub struct TrackBinding {
+    /// The track.
+    pub track: Arc<Track>,
+    /// Arc position of the reference point at t = 0, m.
+    pub s0: f64,
+    /// Running speed, m/s.
+    pub speed: f64,
+    /// Arc offset of each body's track-following frame (its own, or its
+    /// nearest ancestor's), m; `None` for bodies not on a track frame.
+    pub body_offsets: Vec<Option<f64>>,
+    /// Contact tables already built in this run, shared between wheelsets
+    /// with the same profiles and dimensions.
+    pub tables: Mutex<HashMap<String, Arc<PreparedContact>>>,
+}
+
+/// Profiles on the track: the contact table and what is derived from it.
+#[derive(Debug)]
+pub struct PreparedContact {
+    table: ContactTable,
+    /// Mean nominal rolling radius r₀, m.
+    nominal_radius: f64,
+    /// Largest contact angle found in the table (the flange angle), rad.
+    flange_angle: f64,
+}
+
+/// Material and law constants from the parameters.
+#[derive(Debug, Clone, Copy, Default)]
+struct Constants {
+    radius: f64,
+    flange_back_distance: f64,
+    taping_offset: f64,
+    mu: f64,
+    /// Effective modulus E*, Pa.
+    e_star: f64,
+    /// Combined shear modulus G = E/(2(1 + ν)), Pa.
+    shear: f64,
+    poisson: f64,
+    normal_damping: f64,
+    /// Mueller exponent.
+    exponent: f64,
+}
+
+/// Where the element is on the track (after [`ForceElement::bind_track`]).
+struct Bound {
+    track: Arc<Track>,
+    s0: f64,
+    speed: f64,
+    offset: f64,
+    contact: Arc<PreparedContact>,
+    law: Box<dyn CreepLaw + Send + Sync>,
+    /// Nadal's limit of Y/Q for the flange angle and μ.
+    nadal: f64,
+}
+
+/// One solved contact.
+#[derive(Debug, Clone, Copy, Default)]
+struct ContactState {
+    /// Point of application (on the rail surface), SC0, m.
+    point: Vector3<f64>,
+    /// Contact frame in SC0.
+    ex: Vector3<f64>,
+    ey: Vector3<f64>,
+    n: Vector3<f64>,
+    /// Normal force, N.
+    normal: f64,
+    /// dN/dδ, N/m.
+    normal_stiffness: f64,
+    creepages: Creepages,
+    forces: CreepForces,
+    /// Linear creep coefficients f11 = G a b C11, f22 = G a b C22 (N), times the
+    /// saturation ratio (|F| / linear |F|, ≤ 1), for the Jacobian.
+    f11: f64,
+    f22: f64,
+    /// Rolling speed, m/s.
+    speed: f64,
+    /// Contact angle, rad; lateral position of the contact on the rail (track
+    /// frame, m).
+    angle: f64,
+    rail_y: f64,
+}
+
+impl ContactState {
+    /// Total force on the wheel, SC0, N.
+    fn force(&self) -> Vector3<f64> {
+        self.n * self.normal + self.ex * self.forces.fx + self.ey * self.forces.fy
+    }
+}
+
+/// Both wheels at one state.
+#[derive(Debug, Clone, Copy, Default)]
+struct WheelsetState {
+    /// Per side (left, right): contacts (up to two) and how many.
+    contacts: [[ContactState; 2]; 2],
+    count: [usize; 2],
+    /// Track frame axes in SC0 (columns x, y, z).
+    track_axes: Matrix3<f64>,
+}
+
+impl WheelsetState {
+    /// The contacts of side 0 (left) or 1 (right).
+    fn side(&self, side: usize) -> &[ContactState] {
+        &self.contacts[side][..self.count[side]]
+    }
+}
+
+/// The wheel–rail element of one wheelset.
+pub struct WheelRailContact {
+    name: String,
+    spec: WheelRail,
+    c: Constants,
+    bound: Option<Bound>,
+    /// Running maxima over accepted steps, for the assessment summary.
+    maxima: Maxima,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Maxima {
+    /// max Y/Q per side and the time.
+    y_over_q: [(f64, f64); 2],
+    /// max |ΣY| (N) and the time.
+    sum_y: (f64, f64),
+    /// max Q per side (N) and the time.
+    q: [(f64, f64); 2],
+    /// Σ (Q_left + Q_right) over accepted steps and their count: the mean axle
+    /// load for Prud'homme's limit.
+    axle_load_sum: f64,
+    samples: usize,
+}
+
+impl std::fmt::Debug for WheelRailContact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WheelRailContact")
+            .field("name", &self.name)
+            .field("wheelset", &self.spec.wheelset)
+            .field("bound", &self.bound.is_some())
+            .finish()
+    }
+}
+
+impl WheelRailContact {
+    pub fn new(name: String, spec: &WheelRail) -> Self {
+        Self {
+            name,
+            spec: spec.clone(),
+            c: Constants::default(),
+            bound: None,
+            maxima: Maxima::default(),
+        }
+    }
+
+    fn err(&self, message: impl std::fmt::Display) -> SimError {
+        SimError::Other(format!("wheel–rail element \"{}\": {message}", self.name))
+    }
+
+    fn diverged(&self, t: f64, message: impl std::fmt::Display) -> SimError {
+        SimError::Diverged {
+            t,
+            reason: format!("wheel–rail element \"{}\": {message}", self.name),
+        }
+    }
+
+    /// Reads the profiles and builds (or reuses) the contact table.
+    fn prepare(&self, binding: &TrackBinding) -> Result<Arc<PreparedContact>, SimError> {
+        let track = &binding.track;
+        let t = &self.spec.table;
+        let key = format!(
+            "{:?}|{:?}|{}|{}|{}|{}|{}|{}|{}|{}|{}|{}",
+            self.spec.wheel_profiles,
+            self.spec.rail_profiles,
+            self.spec.rail_profiles_inclined,
+            self.c.radius,
+            self.c.flange_back_distance,
+            self.c.taping_offset,
+            track.nominal_gauge(),
+            track.rail_inclination(),
+            t.y_max,
+            t.dy,
+            t.roll_max,
+            t.droll
+        );
+        let mut tables = binding
+            .tables
+            .lock()
+            .map_err(|_| self.err("contact table cache poisoned"))?;
+        if let Some(p) = tables.get(&key) {
+            return Ok(p.clone());
+        }
+        let read = |path: &PathBuf, kind: ProfileKind, inclination: f64| {
+            let settings = ProfileSettings {
+                rail_inclination: inclination,
+                ..ProfileSettings::default()
+            };
+            Profile::read(path, kind, &settings)
+                .map_err(|e| self.err(format!("{}: {e}", path.display())))
+        };
+        let inclination = if self.spec.rail_profiles_inclined {
+            0.0
+        } else {
+            track.rail_inclination().atan()
+        };
+        let wheelset = geometry::Wheelset::new(
+            read(&self.spec.wheel_profiles[0], ProfileKind::Wheel, 0.0)?,
+            read(&self.spec.wheel_profiles[1], ProfileKind::Wheel, 0.0)?,
+            self.c.radius,
+            self.c.flange_back_distance,
+        );
+        let wheelset = geometry::Wheelset {
+            taping_line_offset: self.c.taping_offset,
+            ..wheelset
+        };
+        let rails = geometry::Track::new(
+            read(&self.spec.rail_profiles[0], ProfileKind::Rail, inclination)?,
+            read(&self.spec.rail_profiles[1], ProfileKind::Rail, inclination)?,
+            track.nominal_gauge(),
+        );
+        let table = ContactTable::new(
+            &wheelset,
+            &rails,
+            SearchSettings::default(),
+            TableSettings {
+                y_max: t.y_max,
+                dy: t.dy,
+                roll_max: t.roll_max,
+                droll: t.droll,
+            },
+        )
+        .map_err(|e| self.err(format!("contact table: {e}")))?;
+        let flange_angle = table
+            .rigid_functions()
+            .iter()
+            .flat_map(|r| r.sides.iter().flat_map(|s| s.as_slice().iter()))
+            .map(|c| c.contact_angle)
+            .fold(0.0, f64::max);
+        let prepared = Arc::new(PreparedContact {
+            nominal_radius: self.c.radius,
+            table,
+            flange_angle,
+        });
+        tables.insert(key, prepared.clone());
+        Ok(prepared)
+    }
+
+    /// Solves both wheels' contacts at the context's state.
+    fn solve(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+        let Some(b) = &self.bound else {
+            return Err(self.err(
+                "no track: a wheel–rail element needs the scenario's track (`track: (file: …)`)",
+            ));
+        };
+        let t = ctx.t;
+        let s = b.s0 + b.speed * t + b.offset;
+        let frame = b
+            .track
+            .frame(s, b.speed, 0.0)
+            .map_err(|e| self.diverged(t, format!("track at s = {s:.3} m: {e}")))?;
+        let r = &frame.rotation;
+        let axes = Matrix3::new(
+            r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
+        );
+        let origin = Vector3::from(frame.position);
+        let body = &ctx.bodies[self.spec.wheelset];
+        // Pose relative to the design track frame.
+        let rel = axes.transpose() * (body.position - origin);
+        let axle = body.rotation.column(1).into_owned();
+        let axle_t = axes.transpose() * axle;
+        let roll = axle_t.z.clamp(-1.0, 1.0).asin();
+        let yaw = (-axle_t.x).atan2(axle_t.y);
+        // Rails: irregularities at the wheelset's own arc position, plus the
+        // design gauge widening shared equally by both rails.
+        let s_ws = s + rel.x;
+        let dev = b
+            .track
+            .deviation(s_ws)
+            .map_err(|e| self.diverged(t, format!("track irregularity at s = {s_ws:.3} m: {e}")))?;
+        let widening = b
+            .track
+            .point(s_ws)
+            .map_err(|e| self.diverged(t, format!("track at s = {s_ws:.3} m: {e}")))?
+            .gauge
+            - b.track.nominal_gauge();
+        let rail_shift = [
+            (dev.left_lateral + 0.5 * widening, dev.left_vertical),
+            (dev.right_lateral - 0.5 * widening, dev.right_vertical),
+        ];
+        let table = &b.contact.table;
+        let lookup = |y: f64| {
+            table.lookup(y, roll).map_err(|e| {
+                self.diverged(
+                    t,
+                    format!(
+                        "wheelset out of the contact table ({e}); lateral shift {:.2} mm, roll \
+                         {:.4} rad: derailment, or enlarge `table`",
+                        rel.y * 1e3,
+                        roll
+                    ),
+                )
+            })
+        };
+        let left_sets = lookup(rel.y - rail_shift[0].0)?;
+        let right_sets = if rail_shift[1].0 == rail_shift[0].0 {
+            left_sets
+        } else {
+            lookup(rel.y - rail_shift[1].0)?
+        };
+        let sets: [&ContactSet; 2] = [&left_sets[0], &right_sets[1]];
+        let z_geom = rel.z - b.contact.nominal_radius;
+        let mut state = WheelsetState {
+            track_axes: axes,
+            ..WheelsetState::default()
+        };
+        let forward = axes.column(0).into_owned();
+        for side in 0..2 {
+            let (dy, dz) = rail_shift[side];
+            let sign = if side == 0 { 1.0 } else { -1.0 };
+            for c in sets[side].as_slice() {
+                let penetration = -(c.gap + z_geom - dz);
+                if penetration <= 0.0 {
+                    continue;
+                }
+                let st = self.contact(
+                    ctx,
+                    b,
+                    c,
+                    penetration,
+                    sign,
+                    yaw,
+                    rel.x,
+                    dy,
+                    dz,
+                    &axes,
+                    &origin,
+                    &axle,
+                    &forward,
+                )?;
+                if st.normal > 0.0 {
+                    let k = state.count[side];
+                    state.contacts[side][k] = st;
+                    state.count[side] += 1;
+                }
+            }
+        }
+        Ok(state)
+    }
+
+    /// One contact: normal force, frame, creepages and creep forces.
+    #[allow(clippy::too_many_arguments)]
+    fn contact(
+        &self,
+        ctx: &ForceContext,
+        b: &Bound,
+        c: &Contact,
+        penetration: f64,
+        sign: f64,
+        yaw: f64,
+        x_rel: f64,
+        dy: f64,
+        dz: f64,
+        axes: &Matrix3<f64>,
+        origin: &Vector3<f64>,
+        axle: &Vector3<f64>,
+        forward: &Vector3<f64>,
+    ) -> Result<ContactState, SimError> {
+        let t = ctx.t;
+        let body = &ctx.bodies[self.spec.wheelset];
+        let (sd, cd) = c.contact_angle.sin_cos();
+        let approach = penetration * cd;
+        // Hertz shape from the curvatures at the contact.
+        let (curv_a, curv_b) = wheel_rail_curvatures(
+            1.0 / c.wheel_longitudinal_curvature.max(1e-6),
+            c.wheel_transverse_curvature,
+            c.rail_transverse_curvature,
+        );
+        let curv_b = curv_b.max(MIN_CURVATURE_RATIO * curv_a);
+        let shape = HertzShape::with_modulus(curv_a, curv_b, self.c.e_star)
+            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+        let elastic = shape
+            .normal_force(approach)
+            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+        let normal_stiffness = shape.stiffness(approach);
+        // Contact point on the (displaced) rail, in the track frame then SC0.
+        let local = Vector3::new(
+            x_rel + c.longitudinal_offset(yaw),
+            c.rail_y + dy,
+            c.rail_z + dz,
+        );
+        let point = origin + axes * local;
+        let n = axes * Vector3::new(0.0, -sign * sd, cd);
+        let ex = axle.cross(&n).normalize();
+        let ey = n.cross(&ex);
+        let rho = point - body.position;
+        let v_wheel = body.velocity + body.angular_velocity.cross(&rho);
+        // Approach rate: the wheel point moving against the normal.
+        let approach_rate = -v_wheel.dot(&n);
+        let normal = (elastic + self.c.normal_damping * approach_rate).max(0.0);
+        if normal == 0.0 {
+            return Ok(ContactState::default());
+        }
+        let speed = body.velocity.dot(forward).abs().max(MIN_ROLLING_SPEED);
+        let creepages = Creepages {
+            xi: v_wheel.dot(&ex) / speed,
+            eta: v_wheel.dot(&ey) / speed,
+            phi: body.angular_velocity.dot(&n) / speed,
+        };
+        let hertz = shape
+            .contact(normal)
+            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+        let patch = ContactPatch {
+            a: hertz.a,
+            b: hertz.b,
+            g: self.c.shear,
+            nu: self.c.poisson,
+            mu: self.c.mu,
+            n: normal,
+        };
+        let forces = b
+            .law
+            .forces(&patch, &creepages)
+            .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
+        // Linear creep coefficients (Kalker), scaled by the saturation of the
+        // actual forces, for the approximate Jacobian (paper Sect. 6).
+        let k = KalkerCoefficients::interpolate_ab(hertz.a, hertz.b, self.c.poisson)
+            .ok_or_else(|| self.err("Poisson ratio outside Kalker's table"))?;
+        let gab = self.c.shear * hertz.a * hertz.b;
+        let (f11, f22) = (gab * k.c11, gab * k.c22);
+        let linear = (f11 * creepages.xi).hypot(f22 * creepages.eta);
+        let actual = forces.fx.hypot(forces.fy);
+        let ratio = if linear > 0.0 {
+            (actual / linear).min(1.0)
+        } else {
+            1.0
+        };
+        Ok(ContactState {
+            point,
+            ex,
+            ey,
+            n,
+            normal,
+            normal_stiffness: if elastic > 0.0 {
+                normal_stiffness * cd
+            } else {
+                0.0
+            },
+            creepages,
+            forces,
+            f11: f11 * ratio,
+            f22: f22 * ratio,
+            speed,
+            angle: c.contact_angle,
+            rail_y: local.y,
+        })
+    }
+
+    /// Per-side sums in the track frame: (Q, Y) with Q the vertical wheel load
+    /// and Y the lateral force on the rail towards the field side, N.
+    fn wheel_loads(state: &WheelsetState) -> [(f64, f64); 2] {
+        [0, 1].map(|side| {
+            let sign = if side == 0 { 1.0 } else { -1.0 };
+            let f: Vector3<f64> = state.side(side).iter().map(|c| c.force()).sum();
+            let local = state.track_axes.transpose() * f;
+            // Force on the rail is −f; field side is +y on the left, −y on the right.
+            (local.z, -sign * local.y)
+        })
+    }
+}
+
+/// Nadal's limit of Y/Q for flange angle `beta` (rad) and friction `mu`:
+/// (tan β − μ)/(1 + μ tan β) (Nadal 1908).
+pub fn nadal_limit(beta: f64, mu: f64) -> f64 {
+    let t = beta.tan();
+    (t - mu) / (1.0 + mu * t)
+}
+
+/// Prud'homme's limit of the track-shifting force ΣY (N) for axle load `p`
+/// (N): α (10 kN + P/3), α = 0.85 (Prud'homme 1970, the usual factor for
+/// track in service).
+pub fn prudhomme_limit(p: f64) -> f64 {
+    0.85 * (10e3 + p / 3.0)
+}
+
+impl ForceElement for WheelRailContact {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
+        let name = self.name.clone();
+        let ev = |e, field| eval_scalar(e, params, &name, field);
+        let s = &self.spec;
+        let young = ev(&s.young, "young")?;
+        let poisson = ev(&s.poisson, "poisson")?;
+        let c = Constants {
+            radius: ev(&s.radius, "radius")?,
+            flange_back_distance: ev(&s.flange_back_distance, "flange_back_distance")?,
+            taping_offset: ev(&s.taping_offset, "taping_offset")?,
+            mu: ev(&s.mu, "mu")?,
+            e_star: effective_modulus(young, poisson),
+            shear: young / (2.0 * (1.0 + poisson)),
+            poisson,
+            normal_damping: ev(&s.normal_damping, "normal_damping")?,
+            exponent: match &s.creep {
+                CreepLawKind::Mueller { exponent } => ev(exponent, "exponent")?,
+                _ => 0.0,
+            },
+        };
+        for (field, v) in [
+            ("radius", c.radius),
+            ("flange_back_distance", c.flange_back_distance),
+            ("young", young),
+        ] {
+            if v <= 0.0 {
+                return Err(self.err(format!("{field} must be positive, got {v}")));
+            }
+        }
+        if !(0.0..0.5).contains(&poisson) {
+            return Err(self.err(format!("poisson must be in [0, 0.5), got {poisson}")));
+        }
+        if c.mu < 0.0 || c.normal_damping < 0.0 || c.taping_offset < 0.0 {
+            return Err(self.err("mu, normal_damping and taping_offset must not be negative"));
+        }
+        if matches!(s.rail, RailKind::Elastic { .. }) {
+            return Err(self.err(
+                "elastic rails (`rail: Elastic(..)`) are not available in time simulation yet; \
+                 use `rail: Rigid`",
+            ));
+        }
+        let rebind = self.bound.is_some() && (c.radius != self.c.radius);
+        self.c = c;
+        if rebind {
+            return Err(self.err(
+                "changing the wheel radius after the track is bound needs a new contact table",
+            ));
+        }
+        Ok(())
+    }
+
+    fn needs_track(&self) -> bool {
+        true
+    }
+
+    fn bind_track(&mut self, binding: &TrackBinding) -> Result<(), SimError> {
+        let Some(offset) = binding
+            .body_offsets
+            .get(self.spec.wheelset)
+            .copied()
+            .flatten()
+        else {
+            return Err(self.err(
+                "the wheelset is not on a track-following frame: give its joint (or an \
+                 ancestor's) `SixDof(..., track: Some(offset))`",
+            ));
+        };
+        let contact = self.prepare(binding)?;
+        let law: Box<dyn CreepLaw + Send + Sync> = match &self.spec.creep {
+            CreepLawKind::Kalker => Box::new(KalkerLinear),
+            CreepLawKind::Mueller { .. } => {
+                Box::new(Mueller::new(self.c.exponent).map_err(|e| self.err(e))?)
+            }
+            CreepLawKind::Fastsim { nx, ny } => {
+                Box::new(Fastsim::new(*ny, *nx).map_err(|e| self.err(e))?)
+            }
+            CreepLawKind::FastsimA { strips } => {
+                Box::new(FastsimA::new(*strips).map_err(|e| self.err(e))?)
+            }
+        };
+        let nadal = nadal_limit(contact.flange_angle, self.c.mu);
+        self.bound = Some(Bound {
+            track: binding.track.clone(),
+            s0: binding.s0,
+            speed: binding.speed,
+            offset,
+            contact,
+            law,
+            nadal,
+        });
+        Ok(())
+    }
+
+    fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
+        let state = self.solve(ctx)?;
+        let body = Some(self.spec.wheelset);
+        for side in 0..2 {
+            for c in state.side(side) {
+                add_force(wrenches, ctx, body, &c.point, &c.force());
+                add_moment(wrenches, body, &(c.n * c.forces.mz));
+            }
+        }
+        Ok(())
+    }
+
+    fn output_names(&self) -> Vec<String> {
+        let mut names = Vec::new();
+        for side in ["L", "R"] {
+            for n in [
+                "Q [N]",
+                "Y [N]",
+                "Y/Q [-]",
+                "N [N]",
+                "Fx [N]",
+                "Fy [N]",
+                "xi [-]",
+                "eta [-]",
+                "spin [1/m]",
+                "Tgamma [N]",
+                "contact_angle [rad]",
+                "contact_y [m]",
+                "contacts [-]",
+            ] {
+                names.push(format!("{side}.{n}"));
+            }
+        }
+        names.push("SumY [N]".into());
+        names.push("Nadal [-]".into());
+        names
+    }
+
+    fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        let Ok(state) = self.solve(ctx) else {
+            out.extend(std::iter::repeat_n(f64::NAN, 28));
+            return;
+        };
+        let loads = Self::wheel_loads(&state);
+        for (side, &(q, y)) in loads.iter().enumerate() {
+            let contacts = state.side(side);
+            let sum = |f: &dyn Fn(&ContactState) -> f64| contacts.iter().map(f).sum::<f64>();
+            // The contact carrying the largest normal force describes the wheel.
+            let main = contacts
+                .iter()
+                .max_by(|a, b| a.normal.total_cmp(&b.normal))
+                .copied()
+                .unwrap_or_default();
+            out.extend([
+                q,
+                y,
+                if q > 0.0 { y / q } else { 0.0 },
+                sum(&|c| c.normal),
+                sum(&|c| c.forces.fx),
+                sum(&|c| c.forces.fy),
+                main.creepages.xi,
+                main.creepages.eta,
+                main.creepages.phi,
+                // Wear number Tγ = |Fx ξ| + |Fy η| (N), per contact, summed.
+                sum(&|c| {
+                    (c.forces.fx * c.creepages.xi).abs() + (c.forces.fy * c.creepages.eta).abs()
+                }),
+                main.angle,
+                main.rail_y,
+                contacts.len() as f64,
+            ]);
+        }
+        // Track-shifting force: lateral force on the track, positive left =
+        // Y_left − Y_right in field-side terms.
+        out.push(loads[0].1 - loads[1].1);
+        out.push(self.bound.as_ref().map_or(f64::NAN, |b| b.nadal));
+    }
+
+    fn accept_step(&mut self, ctx: &ForceContext) {
+        let Ok(state) = self.solve(ctx) else { return };
+        let loads = Self::wheel_loads(&state);
+        let m = &mut self.maxima;
+        for (side, &(q, y)) in loads.iter().enumerate() {
+            if q > 0.0 && y / q > m.y_over_q[side].0 {
+                m.y_over_q[side] = (y / q, ctx.t);
+            }
+            if q > m.q[side].0 {
+                m.q[side] = (q, ctx.t);
+            }
+        }
+        let sum_y = (loads[0].1 - loads[1].1).abs();
+        if sum_y > m.sum_y.0 {
+            m.sum_y = (sum_y, ctx.t);
+        }
+        m.axle_load_sum += loads[0].0 + loads[1].0;
+        m.samples += 1;
+    }
+
+    fn assessment(&self) -> Vec<super::Assessment> {
+        let m = &self.maxima;
+        if m.samples == 0 {
+            return Vec::new();
+        }
+        let nadal = self.bound.as_ref().map(|b| b.nadal);
+        let axle = m.axle_load_sum / m.samples as f64;
+        let mut rows = Vec::new();
+        for (side, label) in [(0, "left"), (1, "right")] {
+            rows.push(super::Assessment {
+                element: self.name.clone(),
+                quantity: format!("Y/Q {label}"),
+                max: m.y_over_q[side].0,
+                time: m.y_over_q[side].1,
+                limit: nadal,
+                limit_name: "Nadal",
+                unit: "-",
+            });
+        }
+        rows.push(super::Assessment {
+            element: self.name.clone(),
+            quantity: "|ΣY|".into(),
+            max: m.sum_y.0,
+            time: m.sum_y.1,
+            limit: Some(prudhomme_limit(axle)),
+            limit_name: "Prud'homme",
+            unit: "N",
+        });
+        for (side, label) in [(0, "left"), (1, "right")] {
+            rows.push(super::Assessment {
+                element: self.name.clone(),
+                quantity: format!("Q {label}"),
+                max: m.q[side].0,
+                time: m.q[side].1,
+                limit: None,
+                limit_name: "",
+                unit: "N",
+            });
+        }
+        rows
+    }
+
+    fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
+        let state = self.solve(ctx)?;
+        for side in 0..2 {
+            for c in state.side(side) {
+                // f = N n + Fx eₓ + Fy eᵧ on the wheel at the contact point;
+                // d = wheel point − rail point (at rest): ∂N/∂d = −k n,
+                // ∂F/∂ḋ ≈ −(f11/V) eₓeₓᵀ − (f22/V) eᵧeᵧᵀ − c_n nnᵀ.
+                let nn = c.n * c.n.transpose();
+                let kq = -c.normal_stiffness * nn;
+                let kv = -(c.f11 / c.speed) * (c.ex * c.ex.transpose())
+                    - (c.f22 / c.speed) * (c.ey * c.ey.transpose())
+                    - self.c.normal_damping * nn;
+                jac.add_point_pair(None, &c.point, Some(self.spec.wheelset), &c.point, &kq, &kv);
+            }
+        }
+        Ok(())
+    }
+}
