@@ -71,8 +71,13 @@ pub struct ScenarioTrack {
     pub file: PathBuf,
     /// Arc position of the vehicle's reference point at t = 0, m.
     pub start: f64,
-    /// Running speed along the track, m/s (constant).
+    /// Running speed along the track at t = 0, m/s (constant unless
+    /// `speed_profile` is given).
     pub speed: f64,
+    /// Speed profile: knots (t s, v m/s), the speed linear between them and
+    /// held before the first and after the last (e.g. a slow deceleration to
+    /// find a critical speed). Empty for constant speed.
+    pub speed_profile: Vec<(f64, f64)>,
 }
 
 /// A resolved scenario.
@@ -142,7 +147,10 @@ struct RawTrack {
     file: String,
     #[serde(default)]
     start: f64,
-    speed: f64,
+    #[serde(default, deserialize_with = "some")]
+    speed: Option<f64>,
+    #[serde(default)]
+    speed_profile: Vec<(f64, f64)>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -300,6 +308,53 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             ),
         );
     }
+    let track = raw.track.map(|t| {
+        let profile_speed = t.speed_profile.first().map(|k| k.1);
+        check(
+            t.speed.is_some() != profile_speed.is_some(),
+            "track",
+            "the track needs either `speed` (constant) or `speed_profile` (knots (t, v)), not both"
+                .into(),
+        );
+        for (i, &(kt, kv)) in t.speed_profile.iter().enumerate() {
+            check(
+                kt.is_finite() && kv.is_finite() && kv >= 0.0,
+                "speed_profile",
+                format!("speed_profile knot {i} ({kt} s, {kv} m/s) must be finite with v ≥ 0"),
+            );
+            if i > 0 {
+                check(
+                    kt > t.speed_profile[i - 1].0,
+                    "speed_profile",
+                    format!("speed_profile knot {i}: times must increase"),
+                );
+            }
+        }
+        if let Some(&(t0, _)) = t.speed_profile.first() {
+            check(
+                t0 == 0.0,
+                "speed_profile",
+                format!("the first speed_profile knot must be at t = 0, got {t0} s"),
+            );
+        }
+        check(
+            t.start.is_finite(),
+            "start",
+            format!("track start must be finite, got {}", t.start),
+        );
+        let speed = t.speed.or(profile_speed).unwrap_or(0.0);
+        check(
+            speed.is_finite(),
+            "speed",
+            format!("track speed must be finite, got {speed} m/s"),
+        );
+        ScenarioTrack {
+            file: path.parent().unwrap_or(Path::new("")).join(t.file),
+            start: t.start,
+            speed,
+            speed_profile: t.speed_profile,
+        }
+    });
     let mut parameters: Vec<(String, String)> = Vec::new();
     for (name, v) in raw.parameters.0 {
         check(
@@ -319,18 +374,6 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             Value::Text(s) => s,
         };
         parameters.push((name, text));
-    }
-    if let Some(tr) = &raw.track {
-        check(
-            tr.start.is_finite(),
-            "start",
-            format!("track start must be finite, got {}", tr.start),
-        );
-        check(
-            tr.speed.is_finite(),
-            "speed",
-            format!("track speed must be finite, got {} m/s", tr.speed),
-        );
     }
     if !errors.is_empty() {
         errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
@@ -361,11 +404,7 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             forces: raw.output.forces,
         },
         output_file: raw.output_file.map(|f| dir.join(f)),
-        track: raw.track.map(|t| ScenarioTrack {
-            file: dir.join(t.file),
-            start: t.start,
-            speed: t.speed,
-        }),
+        track,
     })
 }
 

@@ -10,7 +10,7 @@ use crate::inputs::{DrivenEquations, InputProvider};
 use crate::integrate::{self, IntegrationStats, ParkSettings, Rk4Settings};
 use crate::model_system::ModelSystem;
 use crate::system::SimError;
-use crate::track_inputs::TrackInputs;
+use crate::track_inputs::{RunningSpeed, TrackInputs};
 use nalgebra::{Matrix3, Vector3};
 use railmbs_models::{IntegratorSpec, JacobianKind, Model, OutputSpec, Scenario};
 use std::io::Write;
@@ -249,10 +249,14 @@ fn drive_track_frames(
         file: spec.file.clone(),
         message: e.to_string(),
     })?;
-    let speed = railmbs_track::ConstantSpeed::new(spec.start, spec.speed)
-        .map_err(|e| setup(format!("track: {e}")))?;
+    let speed = if spec.speed_profile.is_empty() {
+        railmbs_track::ConstantSpeed::new(spec.start, spec.speed).map(RunningSpeed::Constant)
+    } else {
+        railmbs_track::SpeedTable::new(spec.start, &spec.speed_profile).map(RunningSpeed::Profile)
+    }
+    .map_err(|e| setup(format!("track: {e}")))?;
     let track = std::sync::Arc::new(track);
-    let inputs = TrackInputs::for_model(model, params, track.clone(), speed)?;
+    let inputs = TrackInputs::for_model(model, params, track.clone(), speed.clone())?;
     let breakpoints = inputs.breakpoints(0.0, scenario.end_time);
     // Each body's track frame: its own or its nearest ancestor's.
     let mut body_offsets: Vec<Option<f64>> = vec![None; model.bodies.len()];
@@ -267,8 +271,7 @@ fn drive_track_frames(
     }
     let binding = TrackBinding {
         track,
-        s0: spec.start,
-        speed: spec.speed,
+        speed,
         body_offsets,
         tables: Default::default(),
     };

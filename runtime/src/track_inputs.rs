@@ -3,7 +3,7 @@
 use crate::inputs::InputProvider;
 use crate::system::SimError;
 use railmbs_models::Model;
-use railmbs_track::{ConstantSpeed, SpeedLaw, Track};
+use railmbs_track::{ArcMotion, ConstantSpeed, SpeedLaw, SpeedTable, Track, TrackError};
 use std::sync::Arc;
 
 /// Drives every track-following frame of a model along a track: frame k sits
@@ -57,7 +57,63 @@ fn kinks(track: &Track) -> Vec<f64> {
         .collect()
 }
 
-impl InputProvider for TrackInputs<ConstantSpeed> {
+/// The running speed of a scenario: constant, or a profile of knots (t, v).
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunningSpeed {
+    Constant(ConstantSpeed),
+    Profile(SpeedTable),
+}
+
+impl SpeedLaw for RunningSpeed {
+    fn motion(&self, t: f64) -> Result<ArcMotion, TrackError> {
+        match self {
+            RunningSpeed::Constant(c) => c.motion(t),
+            RunningSpeed::Profile(p) => p.motion(t),
+        }
+    }
+}
+
+impl RunningSpeed {
+    /// Times where s̈ jumps (knots of a profile), s.
+    fn knots(&self) -> &[f64] {
+        match self {
+            RunningSpeed::Constant(_) => &[],
+            RunningSpeed::Profile(p) => p.times(),
+        }
+    }
+
+    /// The time in (t0, t1) at which s(t) = `target`, if s passes it there
+    /// (s is non-decreasing: the speed is never negative). Closed form at
+    /// constant speed, bisection to rounding otherwise.
+    fn time_at(&self, target: f64, t0: f64, t1: f64) -> Option<f64> {
+        if let RunningSpeed::Constant(c) = self {
+            if c.v == 0.0 {
+                return None;
+            }
+            let t = (target - c.s0) / c.v;
+            return (t > t0 && t < t1).then_some(t);
+        }
+        let s = |t: f64| self.motion(t).map(|m| m.s).ok();
+        let (mut a, mut b) = (t0, t1);
+        if !(s(a)? < target && s(b)? > target) {
+            return None;
+        }
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if m <= a || m >= b {
+                break;
+            }
+            if s(m)? < target {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        Some(0.5 * (a + b))
+    }
+}
+
+impl InputProvider for TrackInputs<RunningSpeed> {
     fn input_count(&self) -> usize {
         6 * self.offsets.len()
     }
@@ -71,20 +127,23 @@ impl InputProvider for TrackInputs<ConstantSpeed> {
             })
     }
 
-    /// Frame k passes the kink at s_b at t = (s_b − offset_k − s0)/v.
+    /// Frame k passes the kink at s_b when s(t) + offset_k = s_b; a speed
+    /// profile's knots are breakpoints too (the frames' accelerations jump).
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
-        let v = self.speed.v;
-        if v == 0.0 {
-            return Vec::new();
-        }
         let mut times: Vec<f64> = kinks(&self.track)
             .iter()
             .flat_map(|&sb| {
                 self.offsets
                     .iter()
-                    .map(move |off| (sb - off - self.speed.s0) / v)
+                    .filter_map(move |off| self.speed.time_at(sb - off, t0, t1))
             })
-            .filter(|&t| t > t0 && t < t1)
+            .chain(
+                self.speed
+                    .knots()
+                    .iter()
+                    .copied()
+                    .filter(|&t| t > t0 && t < t1),
+            )
             .collect();
         times.sort_by(f64::total_cmp);
         times.dedup_by(|a, b| (*a - *b).abs() < 1e-9);

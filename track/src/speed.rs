@@ -94,6 +94,13 @@ impl SpeedTable {
     }
 }
 
+impl SpeedTable {
+    /// Knot times, s: where s̈ may jump.
+    pub fn times(&self) -> &[f64] {
+        &self.t
+    }
+}
+
 impl SpeedLaw for SpeedTable {
     fn motion(&self, t: f64) -> Result<ArcMotion, TrackError> {
         finite("time t", t)?;

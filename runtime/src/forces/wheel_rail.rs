@@ -34,9 +34,10 @@ use super::{
     ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment, eval_scalar,
 };
 use crate::system::SimError;
+use crate::track_inputs::RunningSpeed;
 use nalgebra::{Matrix3, Vector3};
 use railmbs_models::{CreepLawKind, RailKind, WheelRail};
-use railmbs_track::Track;
+use railmbs_track::{SpeedLaw, Track};
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
 };
@@ -64,10 +65,8 @@ const MIN_CURVATURE_RATIO: f64 = 1.0 / 25.0;
 pub struct TrackBinding {
     /// The track.
     pub track: Arc<Track>,
-    /// Arc position of the reference point at t = 0, m.
-    pub s0: f64,
-    /// Running speed, m/s.
-    pub speed: f64,
+    /// The running speed law s(t) of the reference point.
+    pub speed: RunningSpeed,
     /// Arc offset of each body's track-following frame (its own, or its
     /// nearest ancestor's), m; `None` for bodies not on a track frame.
     pub body_offsets: Vec<Option<f64>>,
@@ -106,8 +105,7 @@ struct Constants {
 /// Where the element is on the track (after [`ForceElement::bind_track`]).
 struct Bound {
     track: Arc<Track>,
-    s0: f64,
-    speed: f64,
+    speed: RunningSpeed,
     offset: f64,
     contact: Arc<PreparedContact>,
     law: Box<dyn CreepLaw + Send + Sync>,
@@ -311,10 +309,14 @@ impl WheelRailContact {
             ));
         };
         let t = ctx.t;
-        let s = b.s0 + b.speed * t + b.offset;
+        let motion = b
+            .speed
+            .motion(t)
+            .map_err(|e| self.diverged(t, format!("running speed: {e}")))?;
+        let s = motion.s + b.offset;
         let frame = b
             .track
-            .frame(s, b.speed, 0.0)
+            .frame(s, motion.s_dot, motion.s_ddot)
             .map_err(|e| self.diverged(t, format!("track at s = {s:.3} m: {e}")))?;
         let r = &frame.rotation;
         let axes = Matrix3::new(
@@ -628,8 +630,7 @@ impl ForceElement for WheelRailContact {
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
         self.bound = Some(Bound {
             track: binding.track.clone(),
-            s0: binding.s0,
-            speed: binding.speed,
+            speed: binding.speed.clone(),
             offset,
             contact,
             law,
