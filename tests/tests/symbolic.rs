@@ -24,7 +24,7 @@ fn close_scaled(a: &DMatrix<f64>, b: &DMatrix<f64>, scale: f64, what: &str, mode
 
 #[test]
 fn symbolic_equals_numeric_on_every_bundled_model() {
-    for model in all_mechanisms() {
+    for model in all_mechanisms().into_iter().chain(all_vehicles()) {
         let mut num = numeric_engine(&model);
         let mut sym = symbolic_engine(&model);
         let mut en = Evaluation::for_equations(&num);
@@ -35,6 +35,12 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
             let t = rng.uniform(0.0, 3.0);
             let q = rng.vec(n, -2.0, 2.0);
             let v = rng.vec(n, -3.0, 3.0);
+            // Track-following frames: a random pose, rates and accelerations.
+            let u = rng.vec(3 * num.input_count(), -2.0, 2.0);
+            if !u.is_empty() {
+                num.set_inputs(&u).unwrap();
+                sym.set_inputs(&u).unwrap();
+            }
             num.evaluate(t, &q, &v, Parts::ALL, &mut en).unwrap();
             sym.evaluate(t, &q, &v, Parts::ALL, &mut es).unwrap();
             close(&es.mass, &en.mass, "M", &model.name);

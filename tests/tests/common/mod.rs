@@ -34,6 +34,23 @@ pub fn all_mechanisms() -> Vec<Model> {
     names.iter().map(|n| mechanism(n)).collect()
 }
 
+/// Every bundled vehicle model (`models/vehicles/*.ron`; subsystem component
+/// files live in subfolders and are covered through the vehicles).
+pub fn all_vehicles() -> Vec<Model> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(model_path("vehicles"))
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            (p.extension()? == "ron").then_some(p)
+        })
+        .collect();
+    paths.sort();
+    paths
+        .iter()
+        .map(|p| railmbs_models::load_model(p).unwrap_or_else(|e| panic!("{e}")))
+        .collect()
+}
+
 /// A system with the numeric engine and the given parameter overrides.
 pub fn numeric_system(
     model: &Model,
