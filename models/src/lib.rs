@@ -200,6 +200,7 @@ pub mod model;
 pub mod parser;
 mod raw;
 pub mod scenario;
+mod visit;
 
 pub use error::{ModelError, ModelErrors};
 pub use expr::{Expr, Func};
