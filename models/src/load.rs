@@ -43,6 +43,7 @@ fn parse_with(text: &str, file: &Path, inc: &mut Includes) -> Result<Loaded, Mod
         loc,
         errors: Vec::new(),
         nested: Vec::new(),
+        failed: Vec::new(),
         names: Vec::new(),
         defaults: None,
         track_offsets: HashMap::new(),
@@ -136,6 +137,9 @@ struct Cx<'a> {
     errors: Vec<ModelError>,
     /// Errors of included files, complete with their inclusion note.
     nested: Vec<ModelError>,
+    /// Prefixes (`"WS1."`) of subsystems that could not be loaded: unknown
+    /// names under them are not reported again.
+    failed: Vec<String>,
     /// Parameter names, index = `Expr::Param` index.
     names: Vec<String>,
     /// Default parameter values, when they could all be evaluated.
@@ -190,6 +194,11 @@ impl Cx<'_> {
         }
     }
 
+    /// True if `name` is under a subsystem that could not be loaded.
+    fn under_failed(&self, name: &str) -> bool {
+        self.failed.iter().any(|p| name.starts_with(p.as_str()))
+    }
+
     /// Records an error at the string literal `literal` or the key `key` inside the element.
     fn err(&mut self, w: &Where, key: Option<&str>, literal: Option<&str>, message: String) {
         let position = self.span_of(w).map(|span| {
@@ -237,6 +246,9 @@ impl Cx<'_> {
                 }
                 Err(pe) => {
                     let msg = match &pe.kind {
+                        ParseErrorKind::UnknownIdentifier(n) if self.under_failed(n) => {
+                            return Expr::Num(f64::NAN);
+                        }
                         ParseErrorKind::UnknownIdentifier(n) => {
                             format!("unknown identifier \"{n}\" in {label} (\"{s}\")")
                         }
@@ -267,7 +279,7 @@ impl Cx<'_> {
 
     fn resolve(&mut self, raw: RawModel, inc: &mut Includes) -> Option<Loaded> {
         let own = self.parameter_names(&raw);
-        let mut subs = self.load_subsystems(&raw, inc)?;
+        let mut subs = self.load_subsystems(&raw, inc);
         let parameters = self.parameters(own, &mut subs);
         let macros = self.macros(&raw, &subs);
         let gravity = self.vec3(&Where::Top, "gravity", &raw.gravity, false);
@@ -410,7 +422,7 @@ impl Cx<'_> {
                 });
             }
         }
-        for sub in subs.iter() {
+        for sub in subs.iter().filter(|s| !s.failed) {
             let model = &sub.loaded.model;
             for (k, (pname, v)) in sub.raw.parameters.0.iter().enumerate() {
                 let w = Where::Override(sub.raw.name.clone(), sub.nth, pname.clone());
@@ -459,7 +471,9 @@ impl Cx<'_> {
             let w = self.param_where(at, own, subs);
             self.err(&w, None, None, message);
         }
+        // Not evaluated with an unloadable subsystem: its parameters are missing.
         if self.errors.is_empty()
+            && self.failed.is_empty()
             && let Ok(values) = evaluate_parameters(&exprs)
         {
             for (i, v) in values.iter().enumerate() {
@@ -631,6 +645,7 @@ impl Cx<'_> {
             }
             match first.get(p.as_str()) {
                 Some(&q) => sub_parent[k] = Some(q),
+                None if self.under_failed(p) => {}
                 None => {
                     let message = unknown_parent(p);
                     self.err(&w, Some("parent"), Some(p), message);
@@ -661,6 +676,7 @@ impl Cx<'_> {
                     }
                     match first.get(p) {
                         Some(&j) => parent[i] = Some(j),
+                        None if self.under_failed(p) => valid[i] = false,
                         None => {
                             let w = Where::Elem(BODY, b.name.clone(), 0);
                             let message = unknown_parent(p);
@@ -1250,6 +1266,7 @@ impl Cx<'_> {
             Some(Target::Body(b)) => (*b, None),
             Some(Target::Conn(b, p)) => (*b, Some(p.clone())),
             Some(Target::Invalid) => (BodyRef::Ground, None),
+            None if self.under_failed(name) => (BodyRef::Ground, None),
             None => {
                 let candidates: Vec<&str> = lookup.names.keys().map(String::as_str).collect();
                 self.err(
@@ -2025,7 +2042,7 @@ struct WheelRailRaw<'r> {
 
 impl Cx<'_> {
     /// Resolves a wheel–rail element: the wheelset body, profile files (paths
-    /// relative to the model file, which must exist), material and friction
+    /// relative to the model file, which must exist; stored canonical), material and friction
     /// values (checked with the defaults), the creep law, rails and table grid.
     fn wheel_rail(&mut self, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> ForceKind {
         let wheelset = match self.body_ref(w, "wheelset", raw.wheelset, lookup) {
@@ -2059,7 +2076,9 @@ impl Cx<'_> {
                     format!("profile file not found: {}", path.display()),
                 );
             }
-            paths.push(path);
+            // Absolute, so that the resolved model does not depend on the
+            // working directory (nor on which file included this one).
+            paths.push(std::fs::canonicalize(&path).unwrap_or(path));
         }
         let e: Vec<Expr> = raw
             .values

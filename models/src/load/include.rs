@@ -73,6 +73,27 @@ pub(super) fn normalize(path: &Path) -> PathBuf {
     out
 }
 
+impl Loaded {
+    /// Stands in for a subsystem that could not be loaded.
+    fn empty() -> Loaded {
+        Loaded {
+            model: Model {
+                name: String::new(),
+                source: None,
+                parameters: Vec::new(),
+                macros: Vec::new(),
+                gravity: std::array::from_fn(|_| Expr::Num(0.0)),
+                bodies: Vec::new(),
+                coordinates: Vec::new(),
+                cut_joints: Vec::new(),
+                forces: Vec::new(),
+                track_frames: Vec::new(),
+            },
+            connections: Vec::new(),
+        }
+    }
+}
+
 impl Includes {
     pub(super) fn top(file: &Path) -> Includes {
         Includes {
@@ -121,6 +142,8 @@ pub(super) struct Sub<'r> {
     pub param_offset: usize,
     /// Its body `j` is the includer's body `body_map[j]`.
     pub body_map: Vec<usize>,
+    /// It could not be loaded (and `loaded` is empty).
+    pub failed: bool,
 }
 
 impl Sub<'_> {
@@ -191,15 +214,16 @@ pub(super) fn close_matches<'a>(name: &str, candidates: impl Iterator<Item = &'a
 }
 
 impl<'a> Cx<'a> {
-    /// Loads the subsystems of this file (each file once per model). Returns
-    /// `None` if any of them could not be loaded (the errors are recorded).
+    /// Loads the subsystems of this file (each file once per model). One
+    /// that cannot be loaded (the errors are recorded) stands in as an empty
+    /// model, and its prefix goes to `self.failed` so that references to its
+    /// names raise no further errors.
     pub(super) fn load_subsystems<'r>(
         &mut self,
         raw: &'r RawModel,
         inc: &mut Includes,
-    ) -> Option<Vec<Sub<'r>>> {
+    ) -> Vec<Sub<'r>> {
         let mut subs = Vec::new();
-        let mut failed = false;
         let dir = self.file.parent().unwrap_or(Path::new("")).to_path_buf();
         for (i, rs) in raw.subsystems.iter().enumerate() {
             let nth = raw.subsystems[..i]
@@ -217,15 +241,24 @@ impl<'a> Cx<'a> {
                         rs.name
                     ),
                 );
-                failed = true;
                 continue;
             }
             if nth > 0 {
                 self.err(&w, Some("name"), None, "duplicate subsystem name".into());
-                failed = true;
                 continue;
             }
+            let prefix = format!("{}.", rs.name);
             let path = normalize(&dir.join(&rs.file));
+            let mut sub = Sub {
+                raw: rs,
+                nth,
+                prefix,
+                path: path.clone(),
+                loaded: Rc::new(Loaded::empty()),
+                param_offset: 0,
+                body_map: Vec::new(),
+                failed: true,
+            };
             let text = match std::fs::read_to_string(&path) {
                 Ok(text) => text,
                 Err(e) => {
@@ -235,7 +268,8 @@ impl<'a> Cx<'a> {
                         Some(&rs.file),
                         format!("cannot read the subsystem file {}: {e}", path.display()),
                     );
-                    failed = true;
+                    self.failed.push(sub.prefix.clone());
+                    subs.push(sub);
                     continue;
                 }
             };
@@ -252,14 +286,16 @@ impl<'a> Cx<'a> {
                     Some(&rs.file),
                     format!("include cycle: {}", chain.join(" -> ")),
                 );
-                failed = true;
+                self.failed.push(sub.prefix.clone());
+                subs.push(sub);
                 continue;
             }
             let loaded = match inc.cache.get(&key) {
                 Some(Some(loaded)) => loaded.clone(),
                 Some(None) => {
                     // Its errors were reported where it was first included.
-                    failed = true;
+                    self.failed.push(sub.prefix.clone());
+                    subs.push(sub);
                     continue;
                 }
                 None => {
@@ -286,22 +322,17 @@ impl<'a> Cx<'a> {
                         Err(errors) => {
                             inc.cache.insert(key, None);
                             self.nested.extend(errors.0);
-                            failed = true;
+                            self.failed.push(sub.prefix.clone());
+                            subs.push(sub);
                             continue;
                         }
                     }
                 }
             };
-            subs.push(Sub {
-                raw: rs,
-                nth,
-                prefix: format!("{}.", rs.name),
-                path,
-                loaded,
-                param_offset: 0,
-                body_map: Vec::new(),
-            });
+            sub.loaded = loaded;
+            sub.failed = false;
+            subs.push(sub);
         }
-        (!failed).then_some(subs)
+        subs
     }
 }
