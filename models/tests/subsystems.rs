@@ -999,3 +999,28 @@ fn a_failed_subsystem_hides_only_its_own_names() {
     );
     assert_eq!(errors.len(), 2, "{errors}");
 }
+
+#[test]
+fn the_includer_uses_subsystem_parameters_by_long_name() {
+    let vehicle = VEHICLE
+        .replacen(
+            "\"lb\": 9.5 }",
+            "\"lb\": 9.5, \"hc\": \"Bogie1.WS1.r0 + 1.5\" },\n    macros: { \"heavy\": { \"Bogie1.WS2.m\": \"2*Bogie1.WS1.m\" } }",
+            1,
+        )
+        .replacen(
+            "joint: SixDof(parent: \"ground\", track: Some(0))",
+            "joint: SixDof(parent: \"ground\", at: (0, 0, \"hc\"), track: Some(0))",
+            1,
+        );
+    let files = tree(&vehicle, BOGIE, WHEELSET);
+    let m = files.load("vehicle.ron").unwrap_or_else(|e| panic!("{e}"));
+    let i = |n: &str| m.parameter_index(n).unwrap();
+    assert_eq!(m.default_parameter_values()[i("hc")], 0.46 + 1.5);
+    let p = m
+        .parameter_values(&[s("heavy")], &[(s("Bogie1.WS1.r0"), s("0.5"))])
+        .unwrap();
+    assert_eq!(p[i("hc")], 2.0);
+    assert_eq!(p[i("Bogie1.WS2.m")], 3000.0);
+    assert_eq!(p[i("Bogie1.WS1.m")], 1500.0);
+}
