@@ -249,9 +249,10 @@ impl Cx<'_> {
                         ParseErrorKind::UnknownIdentifier(n) if self.under_failed(n) => {
                             return Expr::Num(f64::NAN);
                         }
-                        ParseErrorKind::UnknownIdentifier(n) => {
-                            format!("unknown identifier \"{n}\" in {label} (\"{s}\")")
-                        }
+                        ParseErrorKind::UnknownIdentifier(n) => format!(
+                            "unknown identifier \"{n}\" in {label} (\"{s}\"){}",
+                            close_matches(n, self.names.iter().map(String::as_str))
+                        ),
                         ParseErrorKind::TimeNotAllowed => format!(
                             "time t is not allowed in {label} (\"{s}\"); only elementary transforms and applied forces may depend on time"
                         ),
@@ -828,9 +829,10 @@ impl Cx<'_> {
                             // Numbered below, with the coordinates.
                             Motion::Coordinate(_) => Motion::Coordinate(usize::MAX),
                             Motion::Input(m) => {
-                                let frame = &model.track_frames[m / 6];
-                                self.track_offsets
-                                    .insert(name.clone(), shift(&frame.offset));
+                                if let Some(frame) = model.track_frames.get(m / 6) {
+                                    self.track_offsets
+                                        .insert(name.clone(), shift(&frame.offset));
+                                }
                                 Motion::Input(m % 6)
                             }
                         };

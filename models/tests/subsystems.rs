@@ -1024,3 +1024,23 @@ fn the_includer_uses_subsystem_parameters_by_long_name() {
     assert_eq!(p[i("Bogie1.WS2.m")], 3000.0);
     assert_eq!(p[i("Bogie1.WS1.m")], 1500.0);
 }
+
+#[test]
+fn unknown_identifiers_list_close_long_names() {
+    let vehicle = VEHICLE.replacen("\"offset\": \"lb\"", "\"offset\": \"Bogie1.WS1.ofset\"", 1);
+    let files = tree(&vehicle, BOGIE, WHEELSET);
+    let errors = files.errors("vehicle.ron");
+    let e = located(
+        &errors,
+        &files.path("vehicle.ron"),
+        &vehicle,
+        "\"Bogie1.WS1.ofset\"",
+        "subsystem \"Bogie1\"",
+        "unknown identifier \"Bogie1.WS1.ofset\" in the override of \"offset\"",
+    );
+    assert!(
+        e.message
+            .ends_with("; close matches: \"Bogie1.WS1.offset\", \"Bogie1.WS2.offset\""),
+        "{e}"
+    );
+}

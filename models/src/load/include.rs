@@ -197,7 +197,9 @@ fn distance(a: &str, b: &str) -> usize {
 /// (small edit distance, or the same last part of a long name), or `""`.
 pub(super) fn close_matches<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> String {
     let last = name.rsplit('.').next().unwrap_or(name);
-    let limit = (name.chars().count() / 4).clamp(1, 3);
+    // Very short names would match almost anything.
+    let len = name.chars().count();
+    let limit = if len <= 2 { 0 } else { (len / 4).clamp(1, 3) };
     let mut found: Vec<&str> = candidates
         .filter(|c| {
             *c != name && (distance(c, name) <= limit || c.rsplit('.').next() == Some(last))
