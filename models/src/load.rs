@@ -49,15 +49,15 @@ fn parse_with(text: &str, file: &Path, inc: &mut Includes) -> Result<Loaded, Mod
         track_offsets: HashMap::new(),
     };
     let loaded = cx.resolve(raw, inc);
-    match loaded {
-        Some(loaded) if cx.errors.is_empty() && cx.nested.is_empty() => Ok(loaded),
-        _ => {
-            let mut errors = cx.errors;
-            errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
-            inc.annotate(&mut errors);
-            errors.extend(cx.nested);
-            Err(ModelErrors(errors))
-        }
+    if cx.errors.is_empty() && cx.nested.is_empty() {
+        Ok(loaded)
+    } else {
+        let mut errors = cx.errors;
+        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        inc.annotate(&mut errors);
+        // Then the included files' errors, in the order of inclusion.
+        errors.extend(cx.nested);
+        Err(ModelErrors(errors))
     }
 }
 
@@ -278,7 +278,7 @@ impl Cx<'_> {
         std::array::from_fn(|i| self.expr(w, &format!("{label}[{i}]"), label, comps[i], false))
     }
 
-    fn resolve(&mut self, raw: RawModel, inc: &mut Includes) -> Option<Loaded> {
+    fn resolve(&mut self, raw: RawModel, inc: &mut Includes) -> Loaded {
         let own = self.parameter_names(&raw);
         let mut subs = self.load_subsystems(&raw, inc);
         let parameters = self.parameters(own, &mut subs);
@@ -318,7 +318,7 @@ impl Cx<'_> {
             cut_joints,
             forces,
         };
-        Some(Loaded { model, connections })
+        Loaded { model, connections }
     }
 
     /// Validates the names of this file's own parameters and puts them in
@@ -414,11 +414,9 @@ impl Cx<'_> {
         for sub in subs.iter() {
             let offset = sub.param_offset;
             for (i, p) in sub.loaded.model.parameters.iter().enumerate() {
-                let mut default = p.default.clone();
-                default = default.map_params(&mut |j| Expr::Param(j + offset));
                 params.push(Parameter {
                     name: self.names[offset + i].clone(),
-                    default,
+                    default: p.default.map_params(&mut |j| Expr::Param(j + offset)),
                     doc: p.doc.clone(),
                 });
             }
