@@ -241,8 +241,8 @@
 //! of files, `include cycle: vehicle.ron -> bogie.ron -> vehicle.ron`),
 //! overrides of parameters the subsystem does not have (naming the subsystem,
 //! its file and the parameter, at the override), re-attaching a body on a
-//! track-following frame, and masses or inertias made invalid by an
-//! instance's overrides. An error inside an included file names that file, its
+//! track-following frame, and values (masses, inertias, any value not
+//! finite) made invalid by an instance's overrides. An error inside an included file names that file, its
 //! line and column, and how it was included:
 //!
 //! ```text

@@ -306,6 +306,7 @@ impl Cx<'_> {
                 });
             }
         }
+        self.check_instance_values(&subs, &bodies, &coordinates, &cut_joints, &forces);
         let model = Model {
             track_frames,
             name: raw.name.clone(),
@@ -319,6 +320,77 @@ impl Cx<'_> {
             forces,
         };
         Loaded { model, connections }
+    }
+
+    /// The values of the subsystems' elements are finite with the defaults of
+    /// this file (which include the instances' overrides). This file's own
+    /// elements were checked as they were resolved.
+    fn check_instance_values(
+        &mut self,
+        subs: &[Sub],
+        bodies: &[Body],
+        coordinates: &[Coordinate],
+        cut_joints: &[CutJoint],
+        forces: &[ForceElement],
+    ) {
+        let Some(d) = self.defaults.clone() else {
+            return;
+        };
+        let bad = |e: &mut Expr, found: &mut Option<f64>| {
+            let x = e.eval(&d, 0.0);
+            if found.is_none() && !e.has_time() && !x.is_finite() {
+                *found = Some(x);
+            }
+        };
+        let mut problems: Vec<(String, String, f64)> = Vec::new();
+        for b in bodies {
+            let mut found = None;
+            let mut b = b.clone();
+            bad(&mut b.mass, &mut found);
+            b.inertia.iter_mut().for_each(|e| bad(e, &mut found));
+            for el in &mut b.joint {
+                if let Motion::Fixed(e) | Motion::Time(e) = &mut el.motion {
+                    bad(e, &mut found);
+                }
+            }
+            if let Some(x) = found {
+                problems.push((format!("body \"{}\"", b.name), b.name, x));
+            }
+        }
+        for c in coordinates {
+            let mut found = None;
+            let mut c = c.clone();
+            bad(&mut c.initial, &mut found);
+            bad(&mut c.initial_velocity, &mut found);
+            if let Some(x) = found {
+                problems.push((format!("coordinate \"{}\"", c.name), c.name, x));
+            }
+        }
+        for c in cut_joints {
+            let mut found = None;
+            c.clone().exprs_mut(&mut |e| bad(e, &mut found));
+            if let Some(x) = found {
+                problems.push((format!("cut joint \"{}\"", c.name), c.name.clone(), x));
+            }
+        }
+        for f in forces {
+            let mut found = None;
+            f.kind.clone().exprs_mut(&mut |e| bad(e, &mut found));
+            if let Some(x) = found {
+                problems.push((format!("force \"{}\"", f.name), f.name.clone(), x));
+            }
+        }
+        for (what, name, x) in problems {
+            if let Some(sub) = subs.iter().find(|s| name.starts_with(&s.prefix)) {
+                let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
+                self.err(
+                    &w,
+                    None,
+                    None,
+                    format!("{what}, with this instance's parameters: a value is not finite: {x}"),
+                );
+            }
+        }
     }
 
     /// Validates the names of this file's own parameters and puts them in

@@ -1044,3 +1044,30 @@ fn unknown_identifiers_list_close_long_names() {
         "{e}"
     );
 }
+
+#[test]
+fn values_made_non_finite_by_an_override_are_errors() {
+    let ws = WHEELSET.replacen("radius: \"r0\"", "radius: \"sqrt(r0)\"", 1);
+    let bogie = BOGIE.replacen(
+        "\"offset\": \"offset - a\"",
+        "\"offset\": \"offset - a\", \"r0\": \"-a\"",
+        1,
+    );
+    let files = Files::new(&[
+        ("profiles/wheel.prw", "0 0\n1 1\n"),
+        ("profiles/rail.ban", "0 0\n1 1\n"),
+        ("wheelsets/ws.ron", &ws),
+        ("wheelsets/bogie.ron", &bogie.replace("ws.ron", "./ws.ron")),
+    ]);
+    let errors = files.errors("wheelsets/bogie.ron");
+    let text = std::fs::read_to_string(files.path("wheelsets/bogie.ron")).unwrap();
+    located(
+        &errors,
+        &files.path("wheelsets/bogie.ron"),
+        &text,
+        "Subsystem(name: \"WS2\"",
+        "subsystem \"WS2\"",
+        "force \"WS2.Contact\", with this instance's parameters: a value is not finite: NaN",
+    );
+    assert_eq!(errors.len(), 1, "{errors}");
+}
