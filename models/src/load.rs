@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 mod include;
-use include::{Connection, Includes, Loaded, Node, Sub, close_matches};
+use include::{Connection, Includes, Loaded, Node, Sub, close_matches, force_value_problems};
 
 /// Reads and resolves a model file, flattening its subsystems (recursively).
 /// All problems found are returned together.
@@ -373,22 +373,34 @@ impl Cx<'_> {
                 problems.push((format!("cut joint \"{}\"", c.name), c.name.clone(), x));
             }
         }
+        let mut ranges: Vec<(String, String)> = Vec::new();
         for f in forces {
             let mut found = None;
             f.kind.clone().exprs_mut(&mut |e| bad(e, &mut found));
             if let Some(x) = found {
                 problems.push((format!("force \"{}\"", f.name), f.name.clone(), x));
             }
+            for message in force_value_problems(&f.kind, &d) {
+                ranges.push((f.name.clone(), message));
+            }
         }
-        for (what, name, x) in problems {
+        let problems = problems
+            .into_iter()
+            .map(|(what, name, x)| {
+                (
+                    name,
+                    format!("{what}, with this instance's parameters: a value is not finite: {x}"),
+                )
+            })
+            .chain(ranges.into_iter().map(|(name, message)| {
+                let m = format!("force \"{name}\", with this instance's parameters: {message}");
+                (name, m)
+            }));
+        for (name, message) in problems {
+            // Elements of this file were checked when they were resolved.
             if let Some(sub) = subs.iter().find(|s| name.starts_with(&s.prefix)) {
                 let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
-                self.err(
-                    &w,
-                    None,
-                    None,
-                    format!("{what}, with this instance's parameters: a value is not finite: {x}"),
-                );
+                self.err(&w, None, None, message);
             }
         }
     }

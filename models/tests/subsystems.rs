@@ -1070,4 +1070,22 @@ fn values_made_non_finite_by_an_override_are_errors() {
         "force \"WS2.Contact\", with this instance's parameters: a value is not finite: NaN",
     );
     assert_eq!(errors.len(), 1, "{errors}");
+
+    // Range checks of force elements, with the instance's parameters.
+    let files = Files::new(&[
+        ("profiles/wheel.prw", "0 0\n1 1\n"),
+        ("profiles/rail.ban", "0 0\n1 1\n"),
+        ("wheelsets/ws.ron", WHEELSET),
+        ("wheelsets/bogie.ron", &bogie.replace("ws.ron", "./ws.ron")),
+    ]);
+    let errors = files.errors("wheelsets/bogie.ron");
+    located(
+        &errors,
+        &files.path("wheelsets/bogie.ron"),
+        &text,
+        "Subsystem(name: \"WS2\"",
+        "subsystem \"WS2\"",
+        "force \"WS2.Contact\", with this instance's parameters: radius must be positive, got -1.25",
+    );
+    assert_eq!(errors.len(), 1, "{errors}");
 }

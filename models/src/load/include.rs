@@ -338,3 +338,119 @@ impl<'a> Cx<'a> {
         subs
     }
 }
+
+/// The range checks that resolving a force element makes with the default
+/// parameters (stiffnesses positive, dampings not negative, friction
+/// ordering…), on a resolved element with parameter values `d`: used for the
+/// elements of an included subsystem, whose parameters the includer may have
+/// overridden. Messages as the resolver's; NaN values are not reported here.
+pub(super) fn force_value_problems(kind: &ForceKind, d: &[f64]) -> Vec<String> {
+    let mut out = Vec::new();
+    let v = |e: &Expr| e.eval(d, 0.0);
+    let positive = |out: &mut Vec<String>, key: &str, e: &Expr| {
+        let x = v(e);
+        if x.is_finite() && x <= 0.0 {
+            out.push(format!("{key} must be positive, got {x}"));
+        }
+    };
+    let non_negative = |out: &mut Vec<String>, key: &str, e: &Expr| {
+        let x = v(e);
+        if x.is_finite() && x < 0.0 {
+            out.push(format!("{key} must not be negative, got {x}"));
+        }
+    };
+    let friction = |out: &mut Vec<String>, key: &str, sliding: &Expr, key0: &str, stat: &Expr| {
+        let (s, s0) = (v(sliding), v(stat));
+        if s.is_finite() && s < 0.0 {
+            out.push(format!("{key} must not be negative, got {s}"));
+        } else if s.is_finite() && s0.is_finite() && s > s0 {
+            out.push(format!("{key} = {s} must not exceed {key0} = {s0}"));
+        }
+    };
+    match kind {
+        ForceKind::Bipolar { .. } | ForceKind::Linear6 { .. } | ForceKind::Applied { .. } => {}
+        ForceKind::PointPlane {
+            normal,
+            stiffness,
+            damping,
+            tangential_stiffness,
+            tangential_damping,
+            mu_static,
+            mu,
+            ..
+        } => {
+            positive(&mut out, "c", stiffness);
+            positive(&mut out, "ct", tangential_stiffness);
+            non_negative(&mut out, "d", damping);
+            non_negative(&mut out, "dt", tangential_damping);
+            friction(&mut out, "mu", mu, "mu0", mu_static);
+            let len2: f64 = normal.iter().map(|e| v(e).powi(2)).sum();
+            if len2 == 0.0 {
+                out.push("normal must not be zero".into());
+            }
+        }
+        ForceKind::Coulomb {
+            stiffness,
+            damping,
+            static_limit,
+            sliding_force,
+            ..
+        } => {
+            positive(&mut out, "c", stiffness);
+            non_negative(&mut out, "d", damping);
+            friction(&mut out, "sliding", sliding_force, "limit", static_limit);
+        }
+        ForceKind::LoadFriction {
+            c1,
+            c2,
+            mu_static,
+            mu,
+            ..
+        } => {
+            positive(&mut out, "c1", c1);
+            positive(&mut out, "c2", c2);
+            friction(&mut out, "mu", mu, "mu0", mu_static);
+            let m0 = v(mu_static);
+            if m0.is_finite() && m0 >= 1.0 {
+                out.push(format!(
+                    "mu0 must be below 1 (the unloading branch would lock), got {m0}"
+                ));
+            }
+        }
+        ForceKind::Tabulated { table, damping, .. } => {
+            non_negative(&mut out, "d", damping);
+            let xs: Vec<f64> = table.iter().map(|(x, _)| v(x)).collect();
+            if let Some(k) = (1..xs.len())
+                .find(|&k| xs[k].partial_cmp(&xs[k - 1]) != Some(std::cmp::Ordering::Greater))
+            {
+                out.push(format!(
+                    "table deflections must increase: row {k} has {} after {}",
+                    xs[k],
+                    xs[k - 1]
+                ));
+            }
+        }
+        ForceKind::WheelRail(w) => {
+            positive(&mut out, "radius", &w.radius);
+            positive(&mut out, "flange_back_distance", &w.flange_back_distance);
+            positive(&mut out, "young", &w.young);
+            non_negative(&mut out, "taping_offset", &w.taping_offset);
+            non_negative(&mut out, "mu", &w.mu);
+            non_negative(&mut out, "normal_damping", &w.normal_damping);
+            let nu = v(&w.poisson);
+            if nu.is_finite() && !(0.0..=0.5).contains(&nu) {
+                out.push(format!("poisson must be in [0, 0.5], got {nu}"));
+            }
+            if let CreepLawKind::Mueller { exponent } = &w.creep {
+                positive(&mut out, "exponent", exponent);
+            }
+            if let RailKind::Elastic { ky, cy, kz, cz } = &w.rail {
+                positive(&mut out, "ky", ky);
+                positive(&mut out, "kz", kz);
+                non_negative(&mut out, "cy", cy);
+                non_negative(&mut out, "cz", cz);
+            }
+        }
+    }
+    out
+}
