@@ -241,9 +241,12 @@
 //! of files, `include cycle: vehicle.ron -> bogie.ron -> vehicle.ron`),
 //! overrides of parameters the subsystem does not have (naming the subsystem,
 //! its file and the parameter, at the override), re-attaching a body on a
-//! track-following frame, and values (masses, inertias, any value not
-//! finite) made invalid by an instance's overrides. An error inside an included file names that file, its
-//! line and column, and how it was included:
+//! track-following frame, a connection point where a body is needed (a
+//! joint's `parent`, a `WheelRail` wheelset), and values made invalid by an
+//! instance's overrides (masses, inertias, the range checks of force elements,
+//! values that are not finite; reported at the `Subsystem`). An error inside
+//! an included file names that file, its line and column, and how it was
+//! included:
 //!
 //! ```text
 //! bogies/wheelset.ron:18:19: body "axle": unknown identifier "q" in mass ("m + q") (included as "Bogie1.WS1" from vehicles/vehicle.ron:18:9 via bogies/bogie.ron:17:9)
