@@ -1089,3 +1089,62 @@ fn values_made_non_finite_by_an_override_are_errors() {
     );
     assert_eq!(errors.len(), 1, "{errors}");
 }
+
+#[test]
+fn edge_cases_of_overrides_and_parents() {
+    let absorber = std::fs::read_to_string(example("absorber.ron")).unwrap();
+    let rig = |subsystems: &str| {
+        format!(
+            "Model(\n    name: \"rig\",\n    subsystems: [\n        {subsystems}\n    ],\n    bodies: [],\n)\n"
+        )
+    };
+    // parent: "ground" changes nothing.
+    let text = rig(r#"Subsystem(name: "A", file: "absorber.ron", parent: "ground"),"#);
+    let files = Files::new(&[("absorber.ron", &absorber), ("rig.ron", &text)]);
+    let m = files.load("rig.ron").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.bodies[0].parent, BodyRef::Ground);
+
+    // The same parameter overridden twice.
+    let text =
+        rig(r#"Subsystem(name: "A", file: "absorber.ron", parameters: { "m": 1, "m": 2 }),"#);
+    let files = Files::new(&[("absorber.ron", &absorber), ("rig.ron", &text)]);
+    let errors = files.errors("rig.ron");
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.message == "overrides \"m\" twice" && e.element == "subsystem \"A\""),
+        "{errors}"
+    );
+
+    // A subsystem re-attached to its own body: a loop.
+    let text = rig(r#"Subsystem(name: "A", file: "absorber.ron", parent: "A.mass"),"#);
+    let files = Files::new(&[("absorber.ron", &absorber), ("rig.ron", &text)]);
+    let errors = files.errors("rig.ron");
+    located(
+        &errors,
+        &files.path("rig.ron"),
+        &text,
+        "parent: \"A.mass\"",
+        "subsystem \"A\"",
+        "loop in the body tree (body -> its parent): A.mass -> A.mass",
+    );
+
+    // An empty file name; a file that is not a model.
+    let text = rig(r#"Subsystem(name: "A", file: ""),
+        Subsystem(name: "B", file: "notes.txt"),"#);
+    let files = Files::new(&[("notes.txt", "hello"), ("rig.ron", &text)]);
+    let errors = files.errors("rig.ron");
+    located(
+        &errors,
+        &files.path("rig.ron"),
+        &text,
+        "\"\")",
+        "subsystem \"A\"",
+        "cannot read the subsystem file",
+    );
+    let e = errors
+        .iter()
+        .find(|e| e.file == files.path("notes.txt"))
+        .unwrap_or_else(|| panic!("{errors}"));
+    assert!(e.message.contains("(included as \"B\" from "), "{e}");
+}
