@@ -1148,3 +1148,43 @@ fn edge_cases_of_overrides_and_parents() {
         .unwrap_or_else(|| panic!("{errors}"));
     assert!(e.message.contains("(included as \"B\" from "), "{e}");
 }
+
+#[test]
+fn cut_joints_of_subsystems_get_long_names() {
+    let fourbar = Path::new(env!("CARGO_MANIFEST_DIR")).join("mechanisms/fourbar.ron");
+    let original = load_model(&fourbar).unwrap();
+    assert!(!original.cut_joints.is_empty());
+    let text = format!(
+        "Model(\n    name: \"two\",\n    subsystems: [\n        Subsystem(name: \"L\", file: \"{0}\"),\n        Subsystem(name: \"R\", file: \"{0}\"),\n    ],\n    bodies: [],\n)\n",
+        fourbar.display()
+    );
+    let files = Files::new(&[("two.ron", &text)]);
+    let m = files.load("two.ron").unwrap_or_else(|e| panic!("{e}"));
+    let n = original.bodies.len();
+    assert_eq!(m.bodies.len(), 2 * n);
+    assert_eq!(m.cut_joints.len(), 2 * original.cut_joints.len());
+    let body_name = |m: &Model, b: BodyRef| match b {
+        BodyRef::Ground => "ground".to_string(),
+        BodyRef::Body(i) => m.bodies[i].name.clone(),
+    };
+    let (pm, po) = (
+        m.default_parameter_values(),
+        original.default_parameter_values(),
+    );
+    for (k, prefix) in ["L.", "R."].iter().enumerate() {
+        for (j, c) in original.cut_joints.iter().enumerate() {
+            let f = &m.cut_joints[k * original.cut_joints.len() + j];
+            assert_eq!(f.name, format!("{prefix}{}", c.name));
+            for (a, b) in [(f.body1, c.body1), (f.body2, c.body2)] {
+                let expected = match b {
+                    BodyRef::Ground => "ground".to_string(),
+                    _ => format!("{prefix}{}", body_name(&original, b)),
+                };
+                assert_eq!(body_name(&m, a), expected);
+            }
+            assert_eq!(eval3(&f.frame1.origin, &pm), eval3(&c.frame1.origin, &po));
+            assert_eq!(eval3(&f.frame2.origin, &pm), eval3(&c.frame2.origin, &po));
+            assert_eq!(f.constrained, c.constrained);
+        }
+    }
+}
