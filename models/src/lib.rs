@@ -2,8 +2,9 @@
 //!
 //! The model description language of railmbs. A vehicle, a mechanism or a
 //! scenario is described once in a RON file; this crate reads it, resolves
-//! identifiers and expressions, and validates it with errors that name the file,
-//! the element and the RON line and column. The result is a [`Model`] (or a
+//! identifiers and expressions, flattens included subsystems into long names
+//! (`Bogie1.WS2.axle`), and validates it with errors that name the file, the
+//! element and the RON line and column. The result is a [`Model`] (or a
 //! [`Scenario`]) that both engines — the numeric-iterative `runtime` and the
 //! symbolic `codegen` — consume.
 //!
@@ -159,17 +160,101 @@
 //! must be `ground`.
 //! Coordinates are numbered in body order (parents first), then transform order.
 //!
+//! ### Subsystems and connection points
+//!
+//! A model file may include other model files as subsystems (seed paper
+//! Sect. 5): one wheelset file and one bogie file serve every vehicle that
+//! uses them. Two optional top-level fields:
+//!
+//! ```text
+//! subsystems: [
+//!     Subsystem(
+//!         name: "Bogie1",                 // instance name: prefix "Bogie1." (no '.')
+//!         file: "../bogies/bogie.ron",    // a model file, relative to this file
+//!         parameters: { "offset": "lb", "WS2.m": 1000 },  // overrides (optional)
+//!         parent: "carbody",              // optional, see below
+//!     ),
+//! ],
+//! // Named points fixed to bodies (optional): (body, point in its frame).
+//! connections: { "SecondaryLeft": (body: "frame", point: (0, 1.0, 0.4)) },
+//! ```
+//!
+//! Loading flattens everything into one plain [`Model`], so the engines see no
+//! subsystems. The included file is a complete model file, valid on its own and
+//! loaded recursively (vehicle → bogie → wheelset); its `name` and `gravity`
+//! are ignored. Every body, coordinate, cut joint, force element, parameter,
+//! macro and connection point of the instance gets the long name
+//! `<instance>.<name>`: `Bogie1.frame`, `Bogie1.WS2.axle`, the coordinate
+//! `Bogie1.WS2.axle.rz`, the force `Bogie1.Primary1Left`, the parameter
+//! `Bogie1.WS2.m`, the macro `Bogie1.WS2.worn`, the connection point
+//! `Bogie1.WS2.BoxLeft`. In the flattened model, parameters come in this
+//! order: the file's own, then each subsystem's (recursively) in the order of
+//! `subsystems`; bodies are sorted parent-first, the file's own first.
+//!
+//! - **Parameters stay runtime parameters.** An override (`parameters:` of a
+//!   `Subsystem`) names a parameter of the subsystem (by its name in the
+//!   subsystem, e.g. `"offset"`, or a nested one, `"WS2.m"`); its value is an
+//!   expression in the *including* file's namespace, which replaces that
+//!   parameter's default. So `Bogie1.offset` defaults to `lb` and follows a
+//!   change of `lb` (by a macro or a scenario), while a scenario may still set
+//!   `Bogie1.offset` itself. The including file may use the subsystems'
+//!   parameters by long name in its own expressions, defaults and macros.
+//! - **References by long name.** The including file's forces, cut joints
+//!   and joints (`parent`) refer to subsystem bodies by long name
+//!   (`body1: "Bogie1.frame"`). Wherever a force or cut joint takes a body and
+//!   a point, the body may also be a connection point, of this file or by long
+//!   name of a subsystem (`body2: "Bogie1.SecondaryLeft"`): then the point
+//!   (`point2`, `origin`, `points`, default zero) is an offset from the
+//!   connection point, in the same body frame. A connection point's `body` may
+//!   itself be a body or a subsystem's connection point.
+//! - **`parent:`** re-attaches the subsystem's bodies whose joint parent is
+//!   `ground` to that body of the including file (or to another subsystem's
+//!   body, by long name). Bodies on track-following frames must stay on ground
+//!   (an error). Forces of the subsystem that act on `ground` stay on ground.
+//! - **Track-following frames**: an offset such as `track: Some("offset + a")`
+//!   is an expression over the subsystem's parameters, so offsets add up
+//!   through the levels (`Bogie1.WS1.offset` = `lb + a`).
+//! - **Paths** (subsystem files, `WheelRail` profiles) are relative to the file
+//!   they are written in; the resolved model holds canonical (absolute)
+//!   profile paths. [`Model::source`] is the top file.
+//!
+//! `models/mechanisms/subsystems/vehicle.ron` is a complete example (a car body,
+//! two bogies with two wheelsets each, and an absorber re-attached to the car
+//! body); `vehicle_flat.ron` beside it is the same mechanism written out flat.
+//!
 //! ### Validation
 //!
 //! All problems are reported together ([`ModelErrors`]), each as
 //! `file:line:column: element: message`, e.g.
 //! `models/mechanisms/x.ron:12:9: body "link2": mass must be positive, got -1`:
 //! RON syntax, unknown fields, unknown identifiers and bodies, duplicate names
-//! (bodies, coordinates, forces, cut joints, parameters, macros), loops in the
-//! body tree, cycles among parameter defaults, `t` where not allowed, values
-//! that are not finite with the default parameters, non-positive masses,
-//! inertia tensors that are not positive definite or whose principal moments
-//! violate the triangle inequality, cut joints constraining nothing.
+//! (bodies, coordinates, forces, cut joints, parameters, macros, subsystems,
+//! connection points), loops in the body tree, cycles among parameter
+//! defaults, `t` where not allowed, values that are not finite with the
+//! default parameters, non-positive masses, inertia tensors that are not
+//! positive definite or whose principal moments violate the triangle
+//! inequality, cut joints constraining nothing. Unknown names list close
+//! matches (`unknown body "Bogie1.fram" in body2; close matches:
+//! "Bogie1.frame"`).
+//!
+//! Subsystems add: unreadable subsystem files, include cycles (with the chain
+//! of files, `include cycle: vehicle.ron -> bogie.ron -> vehicle.ron`),
+//! overrides of parameters the subsystem does not have (naming the subsystem,
+//! its file and the parameter, at the override), re-attaching a body on a
+//! track-following frame, a connection point where a body is needed (a
+//! joint's `parent`, a `WheelRail` wheelset), and values made invalid by an
+//! instance's overrides (masses, inertias, the range checks of force elements,
+//! values that are not finite; reported at the `Subsystem`). An error inside
+//! an included file names that file, its line and column, and how it was
+//! included:
+//!
+//! ```text
+//! bogies/wheelset.ron:18:19: body "axle": unknown identifier "q" in mass ("m + q") (included as "Bogie1.WS1" from vehicles/vehicle.ron:18:9 via bogies/bogie.ron:17:9)
+//! ```
+//!
+//! A file included several times is loaded once, and its errors are reported
+//! once (with its first inclusion). When a subsystem cannot be loaded, the
+//! including file is still checked, without errors about that instance's names.
 //!
 //! ## Scenario files
 //!
@@ -200,6 +285,7 @@ pub mod model;
 pub mod parser;
 mod raw;
 pub mod scenario;
+mod visit;
 
 pub use error::{ModelError, ModelErrors};
 pub use expr::{Expr, Func};

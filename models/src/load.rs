@@ -9,7 +9,11 @@ use crate::raw::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// Reads and resolves a model file. All problems found are returned together.
+mod include;
+use include::{Connection, Includes, Loaded, Node, Sub, close_matches, force_value_problems};
+
+/// Reads and resolves a model file, flattening its subsystems (recursively).
+/// All problems found are returned together.
 pub fn load_model(path: &Path) -> Result<Model, ModelErrors> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ModelError::new(path, "", format!("cannot read the model file: {e}")))?;
@@ -17,25 +21,42 @@ pub fn load_model(path: &Path) -> Result<Model, ModelErrors> {
 }
 
 /// Resolves model text; `file` names the source in errors and in [`Model::source`].
+/// Subsystem files are read relative to `file`'s folder.
 pub fn parse_model(text: &str, file: &Path) -> Result<Model, ModelErrors> {
+    let mut inc = Includes::top(file);
+    parse_with(text, file, &mut inc).map(|loaded| loaded.model)
+}
+
+/// Resolves the text of `file`, the innermost file of `inc.stack`.
+fn parse_with(text: &str, file: &Path, inc: &mut Includes) -> Result<Loaded, ModelErrors> {
     let loc = Locator::new(text);
-    let raw: RawModel = ron::Options::default()
-        .from_str(text)
-        .map_err(|e| ron_error(&loc, file, e))?;
+    let raw: RawModel = match ron::Options::default().from_str(text) {
+        Ok(raw) => raw,
+        Err(e) => {
+            let mut errors = ron_error(&loc, file, e);
+            inc.annotate(&mut errors.0);
+            return Err(errors);
+        }
+    };
     let mut cx = Cx {
         file,
         loc,
         errors: Vec::new(),
+        nested: Vec::new(),
+        failed: Vec::new(),
         names: Vec::new(),
         defaults: None,
         track_offsets: HashMap::new(),
     };
-    let model = cx.resolve(raw);
-    if cx.errors.is_empty() {
-        Ok(model)
+    let loaded = cx.resolve(raw, inc);
+    if cx.errors.is_empty() && cx.nested.is_empty() {
+        Ok(loaded)
     } else {
         let mut errors = cx.errors;
         errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        inc.annotate(&mut errors);
+        // Then the included files' errors, in the order of inclusion.
+        errors.extend(cx.nested);
         Err(ModelErrors(errors))
     }
 }
@@ -56,6 +77,7 @@ pub(crate) fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError)
 }
 
 const BODY: &[&str] = &["Body"];
+const SUBSYSTEM: &[&str] = &["Subsystem"];
 const CUT: &[&str] = &["CutJoint"];
 const FORCE: &[&str] = &[
     "Spring",
@@ -74,6 +96,7 @@ fn kind_of(ctor: &str) -> &'static str {
         "CutJoint" => "cut joint",
         "Spring" | "Linear6" | "Applied" | "PointPlane" | "Coulomb" | "LoadFriction"
         | "Tabulated" | "WheelRail" => "force",
+        "Subsystem" => "subsystem",
         "Scenario" => "scenario",
         "Model" => "model",
         _ => "element",
@@ -89,6 +112,10 @@ enum Where {
     /// Name, occurrence.
     Param(String, usize),
     Macro(String, usize),
+    /// Connection point name, occurrence.
+    Conn(String, usize),
+    /// The override of parameter `.2` in subsystem `.0` (occurrence `.1`).
+    Override(String, usize, String),
 }
 
 impl Where {
@@ -98,6 +125,8 @@ impl Where {
             Where::Elem(c, n, _) => format!("{} \"{n}\"", kind_of(c[0])),
             Where::Param(n, _) => format!("parameter \"{n}\""),
             Where::Macro(n, _) => format!("macro \"{n}\""),
+            Where::Conn(n, _) => format!("connection \"{n}\""),
+            Where::Override(n, _, _) => format!("subsystem \"{n}\""),
         }
     }
 }
@@ -106,6 +135,11 @@ struct Cx<'a> {
     file: &'a Path,
     loc: Locator<'a>,
     errors: Vec<ModelError>,
+    /// Errors of included files, complete with their inclusion note.
+    nested: Vec<ModelError>,
+    /// Prefixes (`"WS1."`) of subsystems that could not be loaded: unknown
+    /// names under them are not reported again.
+    failed: Vec<String>,
     /// Parameter names, index = `Expr::Param` index.
     names: Vec<String>,
     /// Default parameter values, when they could all be evaluated.
@@ -145,7 +179,24 @@ impl Cx<'_> {
                 let (_, close) = self.loc.group_after(k + 2)?;
                 Some((k, close))
             }
+            Where::Conn(n, nth) => {
+                let map = self.loc.field_group(self.loc.top()?, "connections")?;
+                let k = self.loc.map_entry(map, n, *nth)?;
+                let close = self.loc.group_after(k + 2).map_or(k + 3, |g| g.1);
+                Some((k, close))
+            }
+            Where::Override(n, nth, key) => {
+                let sub = self.loc.element(SUBSYSTEM, n, *nth)?;
+                let map = self.loc.field_group(sub, "parameters")?;
+                let k = self.loc.map_entry(map, key, 0)?;
+                Some((k, k + 3))
+            }
         }
+    }
+
+    /// True if `name` is under a subsystem that could not be loaded.
+    fn under_failed(&self, name: &str) -> bool {
+        self.failed.iter().any(|p| name.starts_with(p.as_str()))
     }
 
     /// Records an error at the string literal `literal` or the key `key` inside the element.
@@ -195,9 +246,13 @@ impl Cx<'_> {
                 }
                 Err(pe) => {
                     let msg = match &pe.kind {
-                        ParseErrorKind::UnknownIdentifier(n) => {
-                            format!("unknown identifier \"{n}\" in {label} (\"{s}\")")
+                        ParseErrorKind::UnknownIdentifier(n) if self.under_failed(n) => {
+                            return Expr::Num(f64::NAN);
                         }
+                        ParseErrorKind::UnknownIdentifier(n) => format!(
+                            "unknown identifier \"{n}\" in {label} (\"{s}\"){}",
+                            close_matches(n, self.names.iter().map(String::as_str))
+                        ),
                         ParseErrorKind::TimeNotAllowed => format!(
                             "time t is not allowed in {label} (\"{s}\"); only elementary transforms and applied forces may depend on time"
                         ),
@@ -223,24 +278,16 @@ impl Cx<'_> {
         std::array::from_fn(|i| self.expr(w, &format!("{label}[{i}]"), label, comps[i], false))
     }
 
-    fn resolve(&mut self, raw: RawModel) -> Model {
-        let parameters = self.parameters(&raw);
-        let macros = self.macros(&raw);
+    fn resolve(&mut self, raw: RawModel, inc: &mut Includes) -> Loaded {
+        let own = self.parameter_names(&raw);
+        let mut subs = self.load_subsystems(&raw, inc);
+        let parameters = self.parameters(own, &mut subs);
+        let macros = self.macros(&raw, &subs);
         let gravity = self.vec3(&Where::Top, "gravity", &raw.gravity, false);
-        let (bodies, coordinates, raw_to_new) = self.bodies(&raw);
-        let body_names: HashMap<&str, usize> = raw
-            .bodies
-            .iter()
-            .enumerate()
-            .rev()
-            .map(|(i, b)| (b.name.as_str(), i))
-            .collect();
-        let lookup = Lookup {
-            names: body_names,
-            raw_to_new,
-        };
-        let cut_joints = self.cut_joints(&raw, &lookup);
-        let forces = self.forces(&raw, &lookup);
+        let (bodies, coordinates, mut lookup) = self.bodies(&raw, &mut subs);
+        let connections = self.connections(&raw, &subs, &mut lookup);
+        let cut_joints = self.cut_joints(&raw, &lookup, &subs);
+        let forces = self.forces(&raw, &lookup, &subs);
         // Number the track-following frames in body order; their input
         // transformations carry the component (0..6) until now.
         let mut bodies = bodies;
@@ -259,7 +306,8 @@ impl Cx<'_> {
                 });
             }
         }
-        Model {
+        self.check_instance_values(&subs, &bodies, &coordinates, &cut_joints, &forces);
+        let model = Model {
             track_frames,
             name: raw.name.clone(),
             source: Some(self.file.to_path_buf()),
@@ -270,12 +318,96 @@ impl Cx<'_> {
             coordinates,
             cut_joints,
             forces,
+        };
+        Loaded { model, connections }
+    }
+
+    /// The values of the subsystems' elements are finite with the defaults of
+    /// this file (which include the instances' overrides). This file's own
+    /// elements were checked as they were resolved.
+    fn check_instance_values(
+        &mut self,
+        subs: &[Sub],
+        bodies: &[Body],
+        coordinates: &[Coordinate],
+        cut_joints: &[CutJoint],
+        forces: &[ForceElement],
+    ) {
+        let Some(d) = self.defaults.clone() else {
+            return;
+        };
+        let bad = |e: &mut Expr, found: &mut Option<f64>| {
+            let x = e.eval(&d, 0.0);
+            if found.is_none() && !e.has_time() && !x.is_finite() {
+                *found = Some(x);
+            }
+        };
+        let mut problems: Vec<(String, String, f64)> = Vec::new();
+        for b in bodies {
+            let mut found = None;
+            let mut b = b.clone();
+            bad(&mut b.mass, &mut found);
+            b.inertia.iter_mut().for_each(|e| bad(e, &mut found));
+            for el in &mut b.joint {
+                if let Motion::Fixed(e) | Motion::Time(e) = &mut el.motion {
+                    bad(e, &mut found);
+                }
+            }
+            if let Some(x) = found {
+                problems.push((format!("body \"{}\"", b.name), b.name, x));
+            }
+        }
+        for c in coordinates {
+            let mut found = None;
+            let mut c = c.clone();
+            bad(&mut c.initial, &mut found);
+            bad(&mut c.initial_velocity, &mut found);
+            if let Some(x) = found {
+                problems.push((format!("coordinate \"{}\"", c.name), c.name, x));
+            }
+        }
+        for c in cut_joints {
+            let mut found = None;
+            c.clone().exprs_mut(&mut |e| bad(e, &mut found));
+            if let Some(x) = found {
+                problems.push((format!("cut joint \"{}\"", c.name), c.name.clone(), x));
+            }
+        }
+        let mut ranges: Vec<(String, String)> = Vec::new();
+        for f in forces {
+            let mut found = None;
+            f.kind.clone().exprs_mut(&mut |e| bad(e, &mut found));
+            if let Some(x) = found {
+                problems.push((format!("force \"{}\"", f.name), f.name.clone(), x));
+            }
+            for message in force_value_problems(&f.kind, &d) {
+                ranges.push((f.name.clone(), message));
+            }
+        }
+        let problems = problems
+            .into_iter()
+            .map(|(what, name, x)| {
+                (
+                    name,
+                    format!("{what}, with this instance's parameters: a value is not finite: {x}"),
+                )
+            })
+            .chain(ranges.into_iter().map(|(name, message)| {
+                let m = format!("force \"{name}\", with this instance's parameters: {message}");
+                (name, m)
+            }));
+        for (name, message) in problems {
+            // Elements of this file were checked when they were resolved.
+            if let Some(sub) = subs.iter().find(|s| name.starts_with(&s.prefix)) {
+                let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
+                self.err(&w, None, None, message);
+            }
         }
     }
 
-    /// Parameters in file order; sets `self.names` and, when they can all be
-    /// evaluated, `self.defaults`.
-    fn parameters(&mut self, raw: &RawModel) -> Vec<Parameter> {
+    /// Validates the names of this file's own parameters and puts them in
+    /// `self.names`; returns their raw values (same order).
+    fn parameter_names<'r>(&mut self, raw: &'r RawModel) -> Vec<&'r ParamValue> {
         let mut kept = Vec::new();
         for (i, (name, pv)) in raw.parameters.0.iter().enumerate() {
             let nth = raw.parameters.0[..i]
@@ -304,51 +436,148 @@ impl Cx<'_> {
             self.names.push(name.clone());
             kept.push(pv);
         }
-        let exprs: Vec<Expr> = kept
+        kept
+    }
+
+    /// Where parameter `i` (of `self.names`) is defined or overridden in this file.
+    fn param_where(&self, i: usize, own: usize, subs: &[Sub]) -> Where {
+        if i < own {
+            return Where::Param(self.names[i].clone(), 0);
+        }
+        for sub in subs {
+            let n = sub.loaded.model.parameters.len();
+            if (sub.param_offset..sub.param_offset + n).contains(&i) {
+                let local = &sub.loaded.model.parameters[i - sub.param_offset].name;
+                let overridden = sub.raw.parameters.0.iter().any(|(k, _)| k == local);
+                return if overridden {
+                    Where::Override(sub.raw.name.clone(), sub.nth, local.clone())
+                } else {
+                    Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth)
+                };
+            }
+        }
+        Where::Top
+    }
+
+    /// Parameters: this file's own (file order), then each subsystem's with
+    /// its prefix, overridden ones taking the override as their default. Sets
+    /// `self.names` and, when they can all be evaluated, `self.defaults`.
+    fn parameters(&mut self, kept: Vec<&ParamValue>, subs: &mut [Sub]) -> Vec<Parameter> {
+        let own = self.names.len();
+        for sub in subs.iter_mut() {
+            sub.param_offset = self.names.len();
+            for p in &sub.loaded.model.parameters {
+                let long = format!("{}{}", sub.prefix, p.name);
+                if self.names[..own].contains(&long) {
+                    let w = Where::Param(long.clone(), 0);
+                    self.err(
+                        &w,
+                        None,
+                        None,
+                        format!(
+                            "duplicate parameter name: subsystem \"{}\" has a parameter \"{}\"",
+                            sub.raw.name, p.name
+                        ),
+                    );
+                }
+                self.names.push(long);
+            }
+        }
+        let mut params: Vec<Parameter> = kept
             .iter()
             .zip(self.names.clone())
             .map(|(pv, name)| {
-                let w = Where::Param(name, 0);
-                self.expr(&w, "the default value", "", &pv.value, false)
+                let w = Where::Param(name.clone(), 0);
+                Parameter {
+                    default: self.expr(&w, "the default value", "", &pv.value, false),
+                    name,
+                    doc: pv.doc.clone(),
+                }
             })
             .collect();
+        for sub in subs.iter() {
+            let offset = sub.param_offset;
+            for (i, p) in sub.loaded.model.parameters.iter().enumerate() {
+                params.push(Parameter {
+                    name: self.names[offset + i].clone(),
+                    default: p.default.map_params(&mut |j| Expr::Param(j + offset)),
+                    doc: p.doc.clone(),
+                });
+            }
+        }
+        for sub in subs.iter().filter(|s| !s.failed) {
+            let model = &sub.loaded.model;
+            for (k, (pname, v)) in sub.raw.parameters.0.iter().enumerate() {
+                let w = Where::Override(sub.raw.name.clone(), sub.nth, pname.clone());
+                let Some(i) = model.parameter_index(pname) else {
+                    let known: Vec<&str> =
+                        model.parameters.iter().map(|p| p.name.as_str()).collect();
+                    self.err(
+                        &w,
+                        None,
+                        None,
+                        format!(
+                            "unknown parameter \"{pname}\" of subsystem file {}{}",
+                            sub.path.display(),
+                            close_matches(pname, known.iter().copied())
+                        ),
+                    );
+                    continue;
+                };
+                if sub.raw.parameters.0[..k].iter().any(|(n, _)| n == pname) {
+                    self.err(&w, None, None, format!("overrides \"{pname}\" twice"));
+                    continue;
+                }
+                let label = format!("the override of \"{pname}\"");
+                params[sub.param_offset + i].default = self.expr(&w, &label, "", v, false);
+            }
+        }
+        let exprs: Vec<Expr> = params.iter().map(|p| p.default.clone()).collect();
         let cycles = find_cycles(&exprs);
         for cycle in &cycles {
             let mut path: Vec<&str> = cycle.iter().map(|&i| self.names[i].as_str()).collect();
             path.push(path[0]);
-            let w = Where::Param(self.names[cycle[0]].clone(), 0);
-            self.err(
-                &w,
-                None,
-                None,
-                format!("cycle in parameter default values: {}", path.join(" -> ")),
-            );
+            let message = format!("cycle in parameter default values: {}", path.join(" -> "));
+            // Prefer a place in this file that the user can edit: an own
+            // parameter, else an override.
+            let at = cycle
+                .iter()
+                .copied()
+                .find(|&i| i < own)
+                .or_else(|| {
+                    cycle
+                        .iter()
+                        .copied()
+                        .find(|&i| matches!(self.param_where(i, own, subs), Where::Override(..)))
+                })
+                .unwrap_or(cycle[0]);
+            let w = self.param_where(at, own, subs);
+            self.err(&w, None, None, message);
         }
+        // Not evaluated with an unloadable subsystem: its parameters are missing.
         if self.errors.is_empty()
+            && self.failed.is_empty()
             && let Ok(values) = evaluate_parameters(&exprs)
         {
             for (i, v) in values.iter().enumerate() {
                 if !v.is_finite() {
-                    let w = Where::Param(self.names[i].clone(), 0);
-                    self.err(&w, None, None, format!("default value is not finite: {v}"));
+                    let w = self.param_where(i, own, subs);
+                    let message = if i < own {
+                        format!("default value is not finite: {v}")
+                    } else {
+                        format!("parameter \"{}\" is not finite: {v}", self.names[i])
+                    };
+                    self.err(&w, None, None, message);
                 }
             }
             if values.iter().all(|v| v.is_finite()) {
                 self.defaults = Some(values);
             }
         }
-        kept.iter()
-            .zip(&self.names)
-            .zip(exprs)
-            .map(|((pv, name), default)| Parameter {
-                name: name.clone(),
-                default,
-                doc: pv.doc.clone(),
-            })
-            .collect()
+        params
     }
 
-    fn macros(&mut self, raw: &RawModel) -> Vec<Macro> {
+    fn macros(&mut self, raw: &RawModel, subs: &[Sub]) -> Vec<Macro> {
         let mut out: Vec<Macro> = Vec::new();
         for (i, (name, assigns)) in raw.macros.0.iter().enumerate() {
             let nth = raw.macros.0[..i].iter().filter(|(n, _)| n == name).count();
@@ -380,13 +609,57 @@ impl Cx<'_> {
                 assignments,
             });
         }
+        // The subsystems' macros, with long names.
+        for sub in subs {
+            let offset = sub.param_offset;
+            for m in &sub.loaded.model.macros {
+                let name = format!("{}{}", sub.prefix, m.name);
+                if let Some(nth) = raw.macros.0.iter().position(|(n, _)| *n == name) {
+                    let w = Where::Macro(name.clone(), nth);
+                    self.err(
+                        &w,
+                        None,
+                        None,
+                        format!(
+                            "duplicate macro name: subsystem \"{}\" has a macro \"{}\"",
+                            sub.raw.name, m.name
+                        ),
+                    );
+                    continue;
+                }
+                let assignments = m
+                    .assignments
+                    .iter()
+                    .map(|(i, e)| (i + offset, e.map_params(&mut |j| Expr::Param(j + offset))))
+                    .collect();
+                out.push(Macro { name, assignments });
+            }
+        }
         out
     }
 
-    /// Bodies in topological order, coordinates, and raw index → new index.
-    fn bodies(&mut self, raw: &RawModel) -> (Vec<Body>, Vec<Coordinate>, Vec<Option<usize>>) {
-        let n = raw.bodies.len();
+    /// Bodies of this file and of its subsystems in topological order
+    /// (parents first; otherwise this file's bodies in file order, then each
+    /// subsystem's in its order), their coordinates, and the names bodies are
+    /// known by. Sets each subsystem's `body_map`.
+    fn bodies(&mut self, raw: &RawModel, subs: &mut [Sub]) -> (Vec<Body>, Vec<Coordinate>, Lookup) {
+        // Nodes: this file's bodies, then every subsystem's bodies.
+        let n_raw = raw.bodies.len();
+        let mut nodes: Vec<Node> = (0..n_raw).map(Node::Raw).collect();
+        let mut names: Vec<String> = raw.bodies.iter().map(|b| b.name.clone()).collect();
+        let mut sub_first = Vec::with_capacity(subs.len());
+        for (k, sub) in subs.iter().enumerate() {
+            sub_first.push(nodes.len());
+            for (j, b) in sub.loaded.model.bodies.iter().enumerate() {
+                nodes.push(Node::Sub(k, j));
+                names.push(format!("{}{}", sub.prefix, b.name));
+            }
+        }
+        let n = nodes.len();
         let mut first: HashMap<&str, usize> = HashMap::new();
+        for (i, name) in names.iter().enumerate().skip(n_raw) {
+            first.insert(name.as_str(), i);
+        }
         let mut valid = vec![true; n];
         for (i, b) in raw.bodies.iter().enumerate() {
             let nth = raw.bodies[..i].iter().filter(|o| o.name == b.name).count();
@@ -407,37 +680,108 @@ impl Cx<'_> {
                     "\"ground\" is the inertial frame and cannot name a body".into(),
                 );
                 valid[i] = false;
-            } else if first.contains_key(b.name.as_str()) {
-                self.err(&w, Some("name"), None, "duplicate body name".into());
+            } else if let Some(&other) = first.get(b.name.as_str()) {
+                let message = match nodes[other] {
+                    Node::Sub(k, j) => format!(
+                        "duplicate body name: subsystem \"{}\" has a body \"{}\"",
+                        subs[k].raw.name, subs[k].loaded.model.bodies[j].name
+                    ),
+                    Node::Raw(_) => "duplicate body name".into(),
+                };
+                self.err(&w, Some("name"), None, message);
                 valid[i] = false;
             } else {
                 first.insert(&b.name, i);
             }
         }
-        // Parent of each raw body: None = ground, Some(j) = raw body j.
-        let mut parent: Vec<Option<usize>> = vec![None; n];
-        for (i, b) in raw.bodies.iter().enumerate() {
-            if !valid[i] {
-                continue;
+        let connection_names: Vec<String> = raw
+            .connections
+            .0
+            .iter()
+            .map(|(n, _)| n.clone())
+            .chain(subs.iter().flat_map(|s| {
+                s.loaded
+                    .connections
+                    .iter()
+                    .map(|c| format!("{}{}", s.prefix, c.name))
+            }))
+            .collect();
+        let unknown_parent = |p: &str| {
+            if connection_names.iter().any(|c| c == p) {
+                format!(
+                    "\"{p}\" is a connection point, not a body: a joint's parent must be a body"
+                )
+            } else {
+                format!(
+                    "unknown body \"{p}\" as parent{}",
+                    close_matches(p, names.iter().map(String::as_str))
+                )
             }
-            let p = b.joint.parent();
+        };
+        // The body each subsystem's ground-attached bodies hang on.
+        let mut sub_parent: Vec<Option<usize>> = vec![None; subs.len()];
+        for (k, sub) in subs.iter().enumerate() {
+            let Some(p) = &sub.raw.parent else { continue };
+            let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
             if p == "ground" {
                 continue;
             }
-            match first.get(p) {
-                Some(&j) => parent[i] = Some(j),
+            match first.get(p.as_str()) {
+                Some(&q) => sub_parent[k] = Some(q),
+                None if self.under_failed(p) => {}
                 None => {
-                    let w = Where::Elem(BODY, b.name.clone(), 0);
-                    self.err(
-                        &w,
-                        Some("parent"),
-                        Some(p),
-                        format!("unknown body \"{p}\" as parent"),
-                    );
-                    valid[i] = false;
+                    let message = unknown_parent(p);
+                    self.err(&w, Some("parent"), Some(p), message);
+                }
+            }
+            for t in &sub.loaded.model.track_frames {
+                let body = &sub.loaded.model.bodies[t.body].name;
+                self.err(
+                    &w,
+                    Some("parent"),
+                    Some(p),
+                    format!(
+                        "cannot re-attach body \"{}{body}\" to \"{p}\": it hangs on a track-following frame (SixDof with track), which moves relative to ground",
+                        sub.prefix
+                    ),
+                );
+            }
+        }
+        // Parent node of each node: None = ground.
+        let mut parent: Vec<Option<usize>> = vec![None; n];
+        for i in 0..n {
+            match nodes[i] {
+                Node::Raw(r) => {
+                    let b = &raw.bodies[r];
+                    let p = b.joint.parent();
+                    if !valid[i] || p == "ground" {
+                        continue;
+                    }
+                    match first.get(p) {
+                        Some(&j) => parent[i] = Some(j),
+                        None if self.under_failed(p) => valid[i] = false,
+                        None => {
+                            let w = Where::Elem(BODY, b.name.clone(), 0);
+                            let message = unknown_parent(p);
+                            self.err(&w, Some("parent"), Some(p), message);
+                            valid[i] = false;
+                        }
+                    }
+                }
+                Node::Sub(k, j) => {
+                    let model = &subs[k].loaded.model;
+                    parent[i] = match model.bodies[j].parent {
+                        BodyRef::Body(pj) => Some(sub_first[k] + pj),
+                        BodyRef::Ground if model.track_frames.iter().any(|t| t.body == j) => None,
+                        BodyRef::Ground => sub_parent[k],
+                    };
                 }
             }
         }
+        let node_where = |i: usize| match nodes[i] {
+            Node::Raw(r) => Where::Elem(BODY, raw.bodies[r].name.clone(), 0),
+            Node::Sub(k, _) => Where::Elem(SUBSYSTEM, subs[k].raw.name.clone(), subs[k].nth),
+        };
         // Topological order, keeping file order where possible; detect loops.
         // state: 0 unvisited, 1 placed, 2 excluded (in or below a loop, or invalid).
         let mut state = vec![0u8; n];
@@ -464,17 +808,22 @@ impl Cx<'_> {
                 }
                 if let Some(k) = path.iter().position(|&p| p == c) {
                     let cycle: &[usize] = &path[k..];
-                    let mut names: Vec<&str> =
-                        cycle.iter().map(|&j| raw.bodies[j].name.as_str()).collect();
-                    names.push(names[0]);
-                    let w = Where::Elem(BODY, raw.bodies[cycle[0]].name.clone(), 0);
+                    let mut cycle_names: Vec<&str> =
+                        cycle.iter().map(|&j| names[j].as_str()).collect();
+                    cycle_names.push(cycle_names[0]);
+                    // Report at a body of this file if the loop has one.
+                    let at = cycle
+                        .iter()
+                        .copied()
+                        .find(|&j| j < n_raw)
+                        .unwrap_or(cycle[0]);
                     self.err(
-                        &w,
+                        &node_where(at),
                         Some("parent"),
                         None,
                         format!(
                             "loop in the body tree (body -> its parent): {}",
-                            names.join(" -> ")
+                            cycle_names.join(" -> ")
                         ),
                     );
                     bad = true;
@@ -492,42 +841,116 @@ impl Cx<'_> {
                 }
             }
         }
-        let mut raw_to_new = vec![None; n];
+        let mut node_to_new = vec![None; n];
         for (k, &i) in order.iter().enumerate() {
-            raw_to_new[i] = Some(k);
+            node_to_new[i] = Some(k);
         }
         let mut bodies = Vec::new();
         let mut coords: Vec<Coordinate> = Vec::new();
         for (k, &i) in order.iter().enumerate() {
-            let b = &raw.bodies[i];
-            let w = Where::Elem(BODY, b.name.clone(), 0);
-            let mass = self.expr(&w, "mass", "mass", &b.mass, false);
-            let r = &b.inertia;
-            let inertia = [
-                self.expr(&w, "inertia.ixx", "ixx", &r.ixx, false),
-                self.expr(&w, "inertia.iyy", "iyy", &r.iyy, false),
-                self.expr(&w, "inertia.izz", "izz", &r.izz, false),
-                self.expr(&w, "inertia.ixy", "ixy", &r.ixy, false),
-                self.expr(&w, "inertia.ixz", "ixz", &r.ixz, false),
-                self.expr(&w, "inertia.iyz", "iyz", &r.iyz, false),
-            ];
-            self.check_mass(&w, &mass, &inertia);
             let parent = match parent[i] {
                 None => BodyRef::Ground,
-                Some(j) => BodyRef::Body(raw_to_new[j].unwrap_or(0)),
+                Some(j) => BodyRef::Body(node_to_new[j].unwrap_or(0)),
             };
-            let mut jb = JointBuilder {
-                body: k,
-                body_name: &b.name,
-                joint: Vec::new(),
-                coords: Vec::new(),
+            let (w, body, new_coords) = match nodes[i] {
+                Node::Raw(r) => {
+                    let b = &raw.bodies[r];
+                    let w = Where::Elem(BODY, b.name.clone(), 0);
+                    let mass = self.expr(&w, "mass", "mass", &b.mass, false);
+                    let r = &b.inertia;
+                    let inertia = [
+                        self.expr(&w, "inertia.ixx", "ixx", &r.ixx, false),
+                        self.expr(&w, "inertia.iyy", "iyy", &r.iyy, false),
+                        self.expr(&w, "inertia.izz", "izz", &r.izz, false),
+                        self.expr(&w, "inertia.ixy", "ixy", &r.ixy, false),
+                        self.expr(&w, "inertia.ixz", "ixz", &r.ixz, false),
+                        self.expr(&w, "inertia.iyz", "iyz", &r.iyz, false),
+                    ];
+                    self.check_mass(&w, &mass, &inertia);
+                    let mut jb = JointBuilder {
+                        body: k,
+                        body_name: &b.name,
+                        joint: Vec::new(),
+                        coords: Vec::new(),
+                    };
+                    self.expand_joint(&w, &b.joint, &mut jb);
+                    let body = Body {
+                        name: b.name.clone(),
+                        mass,
+                        inertia,
+                        parent,
+                        joint: jb.joint,
+                    };
+                    (w, body, jb.coords)
+                }
+                Node::Sub(s, j) => {
+                    let sub = &subs[s];
+                    let model = &sub.loaded.model;
+                    let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
+                    let offset = sub.param_offset;
+                    let shift = |e: &Expr| e.map_params(&mut |p| Expr::Param(p + offset));
+                    let cb = &model.bodies[j];
+                    let name = names[i].clone();
+                    let mass = shift(&cb.mass);
+                    let inertia = cb.inertia.each_ref().map(shift);
+                    // The subsystem was checked with its own defaults; with
+                    // this instance's parameters it may no longer be valid.
+                    let before = self.errors.len();
+                    self.check_mass(&w, &mass, &inertia);
+                    for e in &mut self.errors[before..] {
+                        e.message = format!(
+                            "body \"{name}\", with this instance's parameters: {}",
+                            e.message
+                        );
+                    }
+                    let mut joint = Vec::with_capacity(cb.joint.len());
+                    for el in &cb.joint {
+                        let motion = match &el.motion {
+                            Motion::Fixed(e) => Motion::Fixed(shift(e)),
+                            Motion::Time(e) => Motion::Time(shift(e)),
+                            // Numbered below, with the coordinates.
+                            Motion::Coordinate(_) => Motion::Coordinate(usize::MAX),
+                            Motion::Input(m) => {
+                                if let Some(frame) = model.track_frames.get(m / 6) {
+                                    self.track_offsets
+                                        .insert(name.clone(), shift(&frame.offset));
+                                }
+                                Motion::Input(m % 6)
+                            }
+                        };
+                        joint.push(Elementary {
+                            kind: el.kind,
+                            motion,
+                        });
+                    }
+                    let new_coords = model
+                        .coordinates
+                        .iter()
+                        .filter(|c| c.body == j)
+                        .map(|c| Coordinate {
+                            name: format!("{}{}", sub.prefix, c.name),
+                            body: k,
+                            elementary: c.elementary,
+                            initial: shift(&c.initial),
+                            initial_velocity: shift(&c.initial_velocity),
+                        })
+                        .collect();
+                    let body = Body {
+                        name,
+                        mass,
+                        inertia,
+                        parent,
+                        joint,
+                    };
+                    (w, body, new_coords)
+                }
             };
-            self.expand_joint(&w, &b.joint, &mut jb);
-            for mut c in jb.coords {
+            let mut body = body;
+            for mut c in new_coords {
                 if let Some(other) = coords.iter().find(|o| o.name == c.name) {
                     let other_body = bodies
                         .get(other.body)
-                        .map_or(b.name.as_str(), |ob: &Body| ob.name.as_str())
+                        .map_or(body.name.as_str(), |ob: &Body| ob.name.as_str())
                         .to_string();
                     self.err(
                         &w,
@@ -542,22 +965,34 @@ impl Cx<'_> {
                     self.err(&w, Some("coord"), None, "empty coordinate name".into());
                 } else {
                     let global = coords.len();
-                    if let Some(el) = jb.joint.get_mut(c.elementary) {
+                    c.body = k;
+                    if let Some(el) = body.joint.get_mut(c.elementary) {
                         el.motion = Motion::Coordinate(global);
                     }
-                    c.body = k;
                     coords.push(c);
                 }
             }
-            bodies.push(Body {
-                name: b.name.clone(),
-                mass,
-                inertia,
-                parent,
-                joint: jb.joint,
-            });
+            bodies.push(body);
         }
-        (bodies, coords, raw_to_new)
+        let mut lookup = Lookup {
+            names: HashMap::new(),
+        };
+        for (i, name) in names.iter().enumerate() {
+            let target = match node_to_new[i] {
+                Some(k) => Target::Body(BodyRef::Body(k)),
+                // Invalid (reported where it is defined).
+                None => Target::Invalid,
+            };
+            if !lookup.names.contains_key(name) || node_to_new[i].is_some() {
+                lookup.names.insert(name.clone(), target);
+            }
+        }
+        for (k, sub) in subs.iter_mut().enumerate() {
+            sub.body_map = (0..sub.loaded.model.bodies.len())
+                .map(|j| node_to_new[sub_first[k] + j].unwrap_or(0))
+                .collect();
+        }
+        (bodies, coords, lookup)
     }
 
     /// Mass positive; inertia positive definite and physically realizable
@@ -883,42 +1318,136 @@ struct JointBuilder<'a> {
     coords: Vec<Coordinate>,
 }
 
-struct Lookup<'a> {
-    names: HashMap<&'a str, usize>,
-    raw_to_new: Vec<Option<usize>>,
+/// What a name in a force element or cut joint refers to.
+#[derive(Debug, Clone)]
+enum Target {
+    Body(BodyRef),
+    /// A connection point: a point (in the body frame) of a body.
+    Conn(BodyRef, [Expr; 3]),
+    /// A body that is invalid (reported where it is defined).
+    Invalid,
+}
+
+/// Bodies and connection points by (long) name.
+struct Lookup {
+    names: HashMap<String, Target>,
+}
+
+/// `a + b` componentwise, folding literal zeros and numbers.
+fn add3(a: &[Expr; 3], b: [Expr; 3]) -> [Expr; 3] {
+    let mut b = b.into_iter();
+    std::array::from_fn(|k| {
+        let y = b.next().unwrap_or(Expr::Num(0.0));
+        match (&a[k], y) {
+            (x, y) if y.is_zero() => x.clone(),
+            (x, y) if x.is_zero() => y,
+            (Expr::Num(x), Expr::Num(y)) => Expr::Num(x + y),
+            (x, y) => Expr::Add(Box::new(x.clone()), Box::new(y)),
+        }
+    })
 }
 
 impl Cx<'_> {
-    fn body_ref(&mut self, w: &Where, key: &str, name: &str, lookup: &Lookup) -> BodyRef {
+    /// The body (or connection point) `name` written at `key`: the body and
+    /// the connection's point, if it is one.
+    fn target(
+        &mut self,
+        w: &Where,
+        key: &str,
+        name: &str,
+        lookup: &Lookup,
+    ) -> (BodyRef, Option<[Expr; 3]>) {
         if name == "ground" {
-            return BodyRef::Ground;
+            return (BodyRef::Ground, None);
         }
         match lookup.names.get(name) {
-            Some(&i) => match lookup.raw_to_new[i] {
-                Some(k) => BodyRef::Body(k),
-                // The body is invalid (reported where it is defined).
-                None => BodyRef::Ground,
-            },
+            Some(Target::Body(b)) => (*b, None),
+            Some(Target::Conn(b, p)) => (*b, Some(p.clone())),
+            Some(Target::Invalid) => (BodyRef::Ground, None),
+            None if self.under_failed(name) => (BodyRef::Ground, None),
             None => {
+                let candidates: Vec<&str> = lookup.names.keys().map(String::as_str).collect();
                 self.err(
                     w,
                     Some(key),
                     Some(name),
-                    format!("unknown body \"{name}\" in {key}"),
+                    format!(
+                        "unknown body \"{name}\" in {key}{}",
+                        close_matches(name, candidates.into_iter())
+                    ),
                 );
-                BodyRef::Ground
+                (BodyRef::Ground, None)
             }
         }
     }
 
-    fn frame(&mut self, w: &Where, point_key: &str, rot_key: &str, p: &Vec3, r: &Vec3) -> Frame {
-        Frame {
-            origin: self.vec3(w, point_key, p, false),
-            rotation_xyz: self.vec3(w, rot_key, r, false),
+    /// A body; a connection point is an error here.
+    fn body_ref(&mut self, w: &Where, key: &str, name: &str, lookup: &Lookup) -> BodyRef {
+        let (b, conn) = self.target(w, key, name, lookup);
+        if conn.is_some() {
+            self.err(
+                w,
+                Some(key),
+                Some(name),
+                format!("\"{name}\" is a connection point, but {key} needs a body"),
+            );
+        }
+        b
+    }
+
+    /// A body or connection point and a point: `point` is in the body frame,
+    /// relative to the connection point if `name` is one.
+    fn attach(
+        &mut self,
+        w: &Where,
+        (key, name): (&str, &str),
+        (point_key, point): (&str, &Vec3),
+        lookup: &Lookup,
+    ) -> (BodyRef, [Expr; 3]) {
+        let (b, conn) = self.target(w, key, name, lookup);
+        let p = self.vec3(w, point_key, point, false);
+        match conn {
+            Some(c) => (b, add3(&c, p)),
+            None => (b, p),
         }
     }
 
-    fn cut_joints(&mut self, raw: &RawModel, lookup: &Lookup) -> Vec<CutJoint> {
+    /// The two ends of a two-point element (see [`Cx::attach`]).
+    fn two_points(
+        &mut self,
+        w: &Where,
+        (body1, point1): (&str, &Vec3),
+        (body2, point2): (&str, &Vec3),
+        lookup: &Lookup,
+    ) -> (BodyRef, [Expr; 3], BodyRef, [Expr; 3]) {
+        let (b1, p1) = self.attach(w, ("body1", body1), ("point1", point1), lookup);
+        let (b2, p2) = self.attach(w, ("body2", body2), ("point2", point2), lookup);
+        (b1, p1, b2, p2)
+    }
+
+    /// A frame on a body or connection point (see [`Cx::attach`]).
+    #[allow(clippy::too_many_arguments)]
+    fn attach_frame(
+        &mut self,
+        w: &Where,
+        body: (&str, &str),
+        point: (&str, &Vec3),
+        rot_key: &str,
+        rotation: &Vec3,
+        lookup: &Lookup,
+    ) -> (BodyRef, Frame) {
+        let (b, origin) = self.attach(w, body, point, lookup);
+        let rotation_xyz = self.vec3(w, rot_key, rotation, false);
+        (
+            b,
+            Frame {
+                origin,
+                rotation_xyz,
+            },
+        )
+    }
+
+    fn cut_joints(&mut self, raw: &RawModel, lookup: &Lookup, subs: &[Sub]) -> Vec<CutJoint> {
         let mut out: Vec<CutJoint> = Vec::new();
         for (i, c) in raw.cut_joints.iter().enumerate() {
             let nth = raw.cut_joints[..i]
@@ -930,10 +1459,22 @@ impl Cx<'_> {
                 self.err(&w, Some("name"), None, "duplicate cut joint name".into());
                 continue;
             }
-            let body1 = self.body_ref(&w, "body1", &c.body1, lookup);
-            let body2 = self.body_ref(&w, "body2", &c.body2, lookup);
-            let frame1 = self.frame(&w, "point1", "rotation1", &c.point1, &c.rotation1);
-            let frame2 = self.frame(&w, "point2", "rotation2", &c.point2, &c.rotation2);
+            let (body1, frame1) = self.attach_frame(
+                &w,
+                ("body1", &c.body1),
+                ("point1", &c.point1),
+                "rotation1",
+                &c.rotation1,
+                lookup,
+            );
+            let (body2, frame2) = self.attach_frame(
+                &w,
+                ("body2", &c.body2),
+                ("point2", &c.point2),
+                "rotation2",
+                &c.rotation2,
+                lookup,
+            );
             if c.constrain.is_empty() {
                 self.err(
                     &w,
@@ -979,6 +1520,26 @@ impl Cx<'_> {
                 frame2,
                 constrained,
             });
+        }
+        for sub in subs {
+            for c in &sub.loaded.model.cut_joints {
+                let mut c = c.clone();
+                c.name = format!("{}{}", sub.prefix, c.name);
+                sub.renumber_cut(&mut c);
+                if out.iter().any(|o| o.name == c.name) {
+                    let w = Where::Elem(CUT, c.name.clone(), 0);
+                    self.err(
+                        &w,
+                        Some("name"),
+                        None,
+                        format!(
+                            "duplicate cut joint name: subsystem \"{}\" has one too",
+                            sub.raw.name
+                        ),
+                    );
+                }
+                out.push(c);
+            }
         }
         out
     }
@@ -1065,7 +1626,7 @@ impl Cx<'_> {
         }
     }
 
-    fn forces(&mut self, raw: &RawModel, lookup: &Lookup) -> Vec<ForceElement> {
+    fn forces(&mut self, raw: &RawModel, lookup: &Lookup, subs: &[Sub]) -> Vec<ForceElement> {
         let mut out = Vec::new();
         for (i, f) in raw.forces.iter().enumerate() {
             let name = f.name();
@@ -1094,16 +1655,20 @@ impl Cx<'_> {
                     f0,
                     x0,
                     ..
-                } => ForceKind::Bipolar {
-                    body1: self.body_ref(&w, "body1", body1, lookup),
-                    point1: self.vec3(&w, "point1", point1, false),
-                    body2: self.body_ref(&w, "body2", body2, lookup),
-                    point2: self.vec3(&w, "point2", point2, false),
-                    stiffness: self.expr(&w, "c", "c", c, false),
-                    damping: self.expr(&w, "d", "d", d, false),
-                    preload: self.expr(&w, "f0", "f0", f0, false),
-                    free_length: self.expr(&w, "x0", "x0", x0, false),
-                },
+                } => {
+                    let (body1, point1, body2, point2) =
+                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
+                    ForceKind::Bipolar {
+                        body1,
+                        point1,
+                        body2,
+                        point2,
+                        stiffness: self.expr(&w, "c", "c", c, false),
+                        damping: self.expr(&w, "d", "d", d, false),
+                        preload: self.expr(&w, "f0", "f0", f0, false),
+                        free_length: self.expr(&w, "x0", "x0", x0, false),
+                    }
+                }
                 RawForce::Linear6 {
                     body1,
                     point1,
@@ -1116,10 +1681,22 @@ impl Cx<'_> {
                     preload,
                     ..
                 } => {
-                    let body1 = self.body_ref(&w, "body1", body1, lookup);
-                    let frame1 = self.frame(&w, "point1", "rotation1", point1, rotation1);
-                    let body2 = self.body_ref(&w, "body2", body2, lookup);
-                    let frame2 = self.frame(&w, "point2", "rotation2", point2, rotation2);
+                    let (body1, frame1) = self.attach_frame(
+                        &w,
+                        ("body1", body1),
+                        ("point1", point1),
+                        "rotation1",
+                        rotation1,
+                        lookup,
+                    );
+                    let (body2, frame2) = self.attach_frame(
+                        &w,
+                        ("body2", body2),
+                        ("point2", point2),
+                        "rotation2",
+                        rotation2,
+                        lookup,
+                    );
                     let stiffness = self.matrix6(&w, "stiffness", stiffness);
                     let damping = self.matrix6(&w, "damping", damping);
                     let preload = self.vec6(&w, "preload", preload);
@@ -1147,8 +1724,8 @@ impl Cx<'_> {
                     mu,
                     ..
                 } => {
-                    let body_ref = self.body_ref(&w, "body", body, lookup);
-                    let plane_ref = self.body_ref(&w, "plane_body", plane_body, lookup);
+                    let (body_ref, body_conn) = self.target(&w, "body", body, lookup);
+                    let (plane_ref, plane_conn) = self.target(&w, "plane_body", plane_body, lookup);
                     if body_ref == plane_ref && body == plane_body {
                         self.err(
                             &w,
@@ -1163,7 +1740,13 @@ impl Cx<'_> {
                     let points: Vec<[Expr; 3]> = points
                         .iter()
                         .enumerate()
-                        .map(|(k, p)| self.vec3(&w, &format!("points[{k}]"), p, false))
+                        .map(|(k, p)| {
+                            let p = self.vec3(&w, &format!("points[{k}]"), p, false);
+                            match &body_conn {
+                                Some(c) => add3(c, p),
+                                None => p,
+                            }
+                        })
                         .collect();
                     let normal_e = self.vec3(&w, "normal", normal, false);
                     if let Some(defs) = &self.defaults {
@@ -1196,7 +1779,13 @@ impl Cx<'_> {
                         body: body_ref,
                         points,
                         plane_body: plane_ref,
-                        origin: self.vec3(&w, "origin", origin, false),
+                        origin: {
+                            let o = self.vec3(&w, "origin", origin, false);
+                            match &plane_conn {
+                                Some(c) => add3(c, o),
+                                None => o,
+                            }
+                        },
                         normal: normal_e,
                         stiffness,
                         damping,
@@ -1227,11 +1816,13 @@ impl Cx<'_> {
                     self.check_positive(&w, "c", &stiffness);
                     self.check_non_negative(&w, "d", &damping);
                     self.check_friction(&w, "sliding", &sliding_force, "limit", &static_limit);
+                    let (body1, point1, body2, point2) =
+                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
                     ForceKind::Coulomb {
-                        body1: self.body_ref(&w, "body1", body1, lookup),
-                        point1: self.vec3(&w, "point1", point1, false),
-                        body2: self.body_ref(&w, "body2", body2, lookup),
-                        point2: self.vec3(&w, "point2", point2, false),
+                        body1,
+                        point1,
+                        body2,
+                        point2,
                         stiffness,
                         damping,
                         static_limit,
@@ -1271,11 +1862,13 @@ impl Cx<'_> {
                             );
                         }
                     }
+                    let (body1, point1, body2, point2) =
+                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
                     ForceKind::LoadFriction {
-                        body1: self.body_ref(&w, "body1", body1, lookup),
-                        point1: self.vec3(&w, "point1", point1, false),
-                        body2: self.body_ref(&w, "body2", body2, lookup),
-                        point2: self.vec3(&w, "point2", point2, false),
+                        body1,
+                        point1,
+                        body2,
+                        point2,
                         c1,
                         c2,
                         mu_static,
@@ -1330,11 +1923,13 @@ impl Cx<'_> {
                     }
                     let damping = self.expr(&w, "d", "d", d, false);
                     self.check_non_negative(&w, "d", &damping);
+                    let (body1, point1, body2, point2) =
+                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
                     ForceKind::Tabulated {
-                        body1: self.body_ref(&w, "body1", body1, lookup),
-                        point1: self.vec3(&w, "point1", point1, false),
-                        body2: self.body_ref(&w, "body2", body2, lookup),
-                        point2: self.vec3(&w, "point2", point2, false),
+                        body1,
+                        point1,
+                        body2,
+                        point2,
                         table: rows,
                         damping,
                         free_length: self.expr(&w, "x0", "x0", x0, false),
@@ -1392,10 +1987,17 @@ impl Cx<'_> {
                     frame,
                     ..
                 } => {
-                    let body = match self.body_ref(&w, "body", body, lookup) {
+                    let (body_ref, point) =
+                        self.attach(&w, ("body", body), ("point", point), lookup);
+                    let body = match body_ref {
                         BodyRef::Body(k) => k,
                         BodyRef::Ground => {
-                            if body == "ground" {
+                            let on_ground = body == "ground"
+                                || matches!(
+                                    lookup.names.get(body.as_str()),
+                                    Some(Target::Conn(..))
+                                );
+                            if on_ground {
                                 self.err(
                                     &w,
                                     Some("body"),
@@ -1408,7 +2010,7 @@ impl Cx<'_> {
                     };
                     ForceKind::Applied {
                         body,
-                        point: self.vec3(&w, "point", point, false),
+                        point,
                         force: self.vec3(&w, "force", force, true),
                         torque: self.vec3(&w, "torque", torque, true),
                         frame: match frame {
@@ -1421,6 +2023,104 @@ impl Cx<'_> {
             out.push(ForceElement {
                 name: name.to_string(),
                 kind,
+            });
+        }
+        for sub in subs {
+            for f in &sub.loaded.model.forces {
+                let mut f = f.clone();
+                f.name = format!("{}{}", sub.prefix, f.name);
+                let kind = &mut f.kind;
+                sub.renumber_force(kind);
+                if out.iter().any(|o| o.name == f.name) {
+                    let w = Where::Elem(FORCE, f.name.clone(), 0);
+                    self.err(
+                        &w,
+                        Some("name"),
+                        None,
+                        format!(
+                            "duplicate force name: subsystem \"{}\" has one too",
+                            sub.raw.name
+                        ),
+                    );
+                }
+                out.push(f);
+            }
+        }
+        out
+    }
+
+    /// Resolves this file's connection points (after the subsystems', which
+    /// they may refer to) and adds them to `lookup`. Returns the connection
+    /// points this file offers to an includer: its own and its subsystems'.
+    fn connections(
+        &mut self,
+        raw: &RawModel,
+        subs: &[Sub],
+        lookup: &mut Lookup,
+    ) -> Vec<Connection> {
+        let mut out = Vec::new();
+        for sub in subs {
+            let w = Where::Elem(SUBSYSTEM, sub.raw.name.clone(), sub.nth);
+            for c in &sub.loaded.connections {
+                let name = format!("{}{}", sub.prefix, c.name);
+                let mut point = c.point.clone();
+                let mut body = c.body;
+                point.iter_mut().for_each(|e| sub.shift(e));
+                if let BodyRef::Body(b) = &mut body {
+                    sub.body(b);
+                }
+                if lookup.names.contains_key(&name) {
+                    self.err(
+                        &w,
+                        None,
+                        None,
+                        format!("\"{name}\" names both a body and a connection point"),
+                    );
+                    continue;
+                }
+                lookup
+                    .names
+                    .insert(name.clone(), Target::Conn(body, point.clone()));
+                out.push(Connection { name, body, point });
+            }
+        }
+        for (i, (name, c)) in raw.connections.0.iter().enumerate() {
+            let nth = raw.connections.0[..i]
+                .iter()
+                .filter(|(n, _)| n == name)
+                .count();
+            let w = Where::Conn(name.clone(), nth);
+            if !is_identifier(name) {
+                self.err(
+                    &w,
+                    None,
+                    None,
+                    "not a valid name (letters, digits, '_' and '.', starting with a letter or '_')"
+                        .into(),
+                );
+                continue;
+            }
+            if lookup.names.contains_key(name) || name == "ground" {
+                let what = match lookup.names.get(name) {
+                    Some(Target::Conn(..)) => "a connection point",
+                    _ => "a body",
+                };
+                self.err(
+                    &w,
+                    None,
+                    None,
+                    format!("duplicate name: {what} is already called \"{name}\""),
+                );
+                continue;
+            }
+            let (body, point) = self.attach(&w, ("body", &c.body), ("point", &c.point), lookup);
+            lookup
+                .names
+                .insert(name.clone(), Target::Conn(body, point.clone()));
+            out.push(Connection {
+                name: name.clone(),
+                body,
+                point,
             });
         }
         out
@@ -1443,7 +2143,7 @@ struct WheelRailRaw<'r> {
 
 impl Cx<'_> {
     /// Resolves a wheel–rail element: the wheelset body, profile files (paths
-    /// relative to the model file, which must exist), material and friction
+    /// relative to the model file, which must exist; stored canonical), material and friction
     /// values (checked with the defaults), the creep law, rails and table grid.
     fn wheel_rail(&mut self, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> ForceKind {
         let wheelset = match self.body_ref(w, "wheelset", raw.wheelset, lookup) {
@@ -1477,7 +2177,9 @@ impl Cx<'_> {
                     format!("profile file not found: {}", path.display()),
                 );
             }
-            paths.push(path);
+            // Absolute, so that the resolved model does not depend on the
+            // working directory (nor on which file included this one).
+            paths.push(std::fs::canonicalize(&path).unwrap_or(path));
         }
         let e: Vec<Expr> = raw
             .values

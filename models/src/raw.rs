@@ -191,6 +191,39 @@ pub(crate) struct RawModel {
     pub cut_joints: Vec<RawCutJoint>,
     #[serde(default)]
     pub forces: Vec<RawForce>,
+    #[serde(default)]
+    pub subsystems: Vec<RawSubsystem>,
+    #[serde(default)]
+    pub connections: OrderedMap<RawConnection>,
+}
+
+/// An included subsystem: another model file under an instance name.
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Subsystem", deny_unknown_fields)]
+pub(crate) struct RawSubsystem {
+    pub name: String,
+    /// Relative to the including file.
+    pub file: String,
+    /// Overrides of the subsystem's parameters, in the includer's namespace.
+    #[serde(default)]
+    pub parameters: OrderedMap<Value>,
+    /// Body of the includer that the subsystem's ground-attached bodies hang on.
+    #[serde(default, deserialize_with = "some_string")]
+    pub parent: Option<String>,
+}
+
+/// A named connection point: a point fixed to a body.
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Connection", deny_unknown_fields)]
+pub(crate) struct RawConnection {
+    pub body: String,
+    #[serde(default = "zero3")]
+    pub point: Vec3,
+}
+
+/// An optional string written plainly (no `Some(...)`).
+fn some_string<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
+    String::deserialize(d).map(Some)
 }
 
 #[derive(Debug, Deserialize)]

@@ -19,7 +19,7 @@ fn ron_files(folder: &str) -> Vec<PathBuf> {
 #[test]
 fn bundled_models_load() {
     let mut problems = Vec::new();
-    for folder in ["mechanisms", "vehicles"] {
+    for folder in ["mechanisms", "mechanisms/subsystems", "vehicles"] {
         for path in ron_files(folder) {
             match load_model(&path) {
                 Ok(m) => {
