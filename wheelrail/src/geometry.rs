@@ -574,6 +574,67 @@ impl ContactGeometry {
         Ok(set)
     }
 
+    /// The deepest point of each of two fixed regions of wheel `k`'s profile,
+    /// `u ≥ split` (slot 0, the tread side) and `u < split` (slot 1, the
+    /// flange side), for lateral shift `y` and roll `roll` (wheelset height
+    /// z = 0). Unlike [`ContactGeometry::contacts`], whose contact points jump
+    /// where a local minimum of the distance disappears (S1002 on UIC60 at
+    /// the flange root), each slot's gap is a continuous function of y and
+    /// roll (the minimum of a continuous function over a fixed domain), so
+    /// tables of it interpolate without jumps. A slot's minimum may sit on
+    /// the region's boundary; an empty region gets gap 1 m (never in
+    /// contact) and the other slot's geometry.
+    pub fn region_contacts(
+        &self,
+        k: usize,
+        y: f64,
+        roll: f64,
+        split: f64,
+    ) -> Result<[Contact; 2], GeometryError> {
+        let s = &self.sides[k];
+        let ys = s.sign * y;
+        let (ss, cs) = (s.sign * roll).sin_cos();
+        let mut seg = 0;
+        let mut best = [usize::MAX; 2];
+        let mut best_d = [f64::INFINITY; 2];
+        for (i, &(u, h)) in s.samples.iter().enumerate() {
+            if let Some((dist, _)) = self.distance(s, ys, cs, ss, u, h, &mut seg) {
+                let r = usize::from(u < split);
+                if dist < best_d[r] {
+                    best_d[r] = dist;
+                    best[r] = i;
+                }
+            }
+        }
+        let n = s.samples.len();
+        let mut found = [None, None];
+        for r in 0..2 {
+            let i = best[r];
+            if i == usize::MAX {
+                continue;
+            }
+            let mut a = s.samples[i.saturating_sub(1)].0;
+            let mut b = s.samples[(i + 1).min(n - 1)].0;
+            if r == 0 {
+                a = a.max(split);
+            } else {
+                b = b.min(split);
+            }
+            let (u, _) = self.refine(s, ys, cs, ss, a, b);
+            found[r] = Some(self.contact_at(s, ys, cs, ss, u));
+        }
+        match found {
+            [Some(a), Some(b)] => Ok([a, b]),
+            [Some(a), None] => Ok([a, Contact { gap: 1.0, ..a }]),
+            [None, Some(b)] => Ok([Contact { gap: 1.0, ..b }, b]),
+            [None, None] => Err(GeometryError::NoContact {
+                side: if k == 0 { "left" } else { "right" },
+                y,
+                roll,
+            }),
+        }
+    }
+
     /// Golden-section refinement of a minimum of the vertical distance in `[a, b]`.
     fn refine(&self, s: &Side, ys: f64, cs: f64, ss: f64, a: f64, b: f64) -> (f64, f64) {
         let mut wseg = 0;
@@ -806,6 +867,21 @@ pub struct ContactTable {
     dr: f64,
     nodes: Vec<[ContactSet; 2]>,
     rigid: Vec<RigidContact>,
+    /// Per side, the wheel profile coordinate `u` (m) that separates the
+    /// tread and flange regions of [`ContactTable::lookup_regions`].
+    split: [f64; 2],
+    /// Per side, nodes over (w, ψ): w = y_s + sin(φ_s)·R the side-local
+    /// lateral shift of the wheel's lowest point (y_s, φ_s the side-local
+    /// shift and roll, R the wheel radius), ψ = φ_s on the roll grid; per
+    /// node the deepest point of each region. With w instead of y the
+    /// geometry depends only weakly on the roll (a roll mostly moves the
+    /// wheel sideways by R·φ), so the roll grid may stay coarse.
+    regions: [Vec<[Contact; 2]>; 2],
+    /// The w grid: first value and count (step `dy`).
+    w0: f64,
+    nw: usize,
+    /// Wheel radius R per side, m.
+    radius: [f64; 2],
 }
 
 /// Contacts further apart than this on the wheel (m) are not interpolated with each other.
@@ -860,6 +936,24 @@ impl ContactTable {
                 i += dir;
             }
         }
+        let rigid: Vec<RigidContact> = rigid.into_iter().map(|r| r.expect("filled")).collect();
+        let split = [0, 1].map(|side| region_split(&rigid, side));
+        let radius = [geo.sides[0].radius, geo.sides[1].radius];
+        let w_max = settings.y_max + settings.roll_max.sin() * radius[0].max(radius[1]);
+        let nw = 2 * (w_max / settings.dy).ceil() as usize + 1;
+        let w0 = -(((nw - 1) / 2) as f64) * settings.dy;
+        let mut regions = [Vec::with_capacity(nw * nr), Vec::with_capacity(nw * nr)];
+        for (side, nodes) in regions.iter_mut().enumerate() {
+            let sign = geo.sides[side].sign;
+            for i in 0..nw {
+                let w = w0 + i as f64 * settings.dy;
+                for j in 0..nr {
+                    let ps = r0 + j as f64 * settings.droll;
+                    let ys = w - ps.sin() * radius[side];
+                    nodes.push(geo.region_contacts(side, sign * ys, sign * ps, split[side])?);
+                }
+            }
+        }
         Ok(ContactTable {
             ny,
             nr,
@@ -868,7 +962,12 @@ impl ContactTable {
             r0,
             dr: settings.droll,
             nodes,
-            rigid: rigid.into_iter().map(|r| r.expect("filled")).collect(),
+            rigid,
+            split,
+            regions,
+            w0,
+            nw,
+            radius,
         })
     }
 
@@ -915,6 +1014,118 @@ impl ContactTable {
     /// bilinearly interpolated. The contact count follows the nearest node; each contact is
     /// interpolated with the matching contacts (nearest on the wheel) of the surrounding nodes,
     /// so that the tread-to-flange jump is not smeared.
+    /// The wheel profile coordinates `u` (m; left, right wheel) that separate
+    /// the tread and flange regions of [`ContactTable::lookup_regions`]: the
+    /// middle of the jump of the rigid wheelset's contact point (by more than
+    /// 2 mm) that turns the contact normal the most over the table's lateral
+    /// range — the flange-root fold of profiles like S1002 on UIC60 — or −∞
+    /// (one region) if the contact point never jumps.
+    pub fn region_split(&self) -> [f64; 2] {
+        self.split
+    }
+
+    /// The deepest point of the tread and of the flange region of each wheel
+    /// ([`ContactGeometry::region_contacts`]) at lateral shift `y` (m) and
+    /// roll `roll` (rad), wheelset height z = 0: `[side][slot]`, slot 0 the
+    /// tread side. Bilinear interpolation of every quantity between the four
+    /// surrounding nodes, with the gap's rigid-body dependence on roll removed
+    /// before and restored after, so the result is continuous in y and roll —
+    /// what a time integration needs. Both slots are always returned; a slot
+    /// with a positive gap is not in contact. Near the flange root of
+    /// profiles whose contact point jumps, both slots may touch at once: the
+    /// load is then shared by two patches where in reality one conformal
+    /// patch spans both.
+    pub fn lookup_regions(&self, y: f64, roll: f64) -> Result<[[Contact; 2]; 2], GeometryError> {
+        if !(y.is_finite() && roll.is_finite()) {
+            return Err(invalid(
+                "wheelset position",
+                format!("lateral shift {y} and roll {roll} must be finite"),
+            ));
+        }
+        let mut out = [[Contact::default(); 2]; 2];
+        for (side, sign) in [(0, 1.0), (1, -1.0)] {
+            let (ys, ps) = (sign * y, sign * roll);
+            let w = ys + ps.sin() * self.radius[side];
+            let (i, tw) = Self::locate("lateral shift", w, self.w0, self.dy, self.nw)?;
+            let (j, tr) = Self::locate("roll", ps, self.r0, self.dr, self.nr)?;
+            let j1 = (j + 1).min(self.nr - 1);
+            let i1 = (i + 1).min(self.nw - 1);
+            let corners = [
+                (i, j, (1.0 - tw) * (1.0 - tr)),
+                (i1, j, tw * (1.0 - tr)),
+                (i, j1, (1.0 - tw) * tr),
+                (i1, j1, tw * tr),
+            ];
+            let nodes = &self.regions[side];
+            // Gap of a node with its rigid-body roll dependence removed.
+            let reduced = |ci: usize, cj: usize, slot: usize| {
+                let m = &nodes[ci * self.nr + cj][slot];
+                let node_roll = self.r0 + cj as f64 * self.dr;
+                m.gap - (node_roll.sin() * sign * m.wheel_y + (node_roll.cos() - 1.0) * m.wheel_z)
+            };
+            for slot in 0..2 {
+                // The gap along w by cubic Hermite interpolation (slopes by
+                // central differences), linear in roll: continuous with a
+                // continuous slope, so the contact angle taken from the slope
+                // below is continuous too and is the gradient of the gap — the
+                // normal force stays (nearly) conservative even across a jump
+                // of the contact point, where the profile's own contact angle
+                // would switch within one cell.
+                let mut gap = 0.0;
+                let mut slope = 0.0;
+                for (cj, wr) in [(j, 1.0 - tr), (j1, tr)] {
+                    if wr == 0.0 {
+                        continue;
+                    }
+                    let g = |k: isize| {
+                        let k = k.clamp(0, self.nw as isize - 1) as usize;
+                        reduced(k, cj, slot)
+                    };
+                    let (a, b) = (i as isize, i1 as isize);
+                    let (p0, p1) = (g(a), g(b));
+                    let m0 = 0.5 * (p1 - g(a - 1));
+                    let m1 = 0.5 * (g(b + 1) - p0);
+                    let t = tw;
+                    let (t2, t3) = (t * t, t * t * t);
+                    gap += wr
+                        * ((2.0 * t3 - 3.0 * t2 + 1.0) * p0
+                            + (t3 - 2.0 * t2 + t) * m0
+                            + (-2.0 * t3 + 3.0 * t2) * p1
+                            + (t3 - t2) * m1);
+                    slope += wr
+                        * ((6.0 * t2 - 6.0 * t) * p0
+                            + (3.0 * t2 - 4.0 * t + 1.0) * m0
+                            + (-6.0 * t2 + 6.0 * t) * p1
+                            + (3.0 * t2 - 2.0 * t) * m1)
+                        / self.dy;
+                }
+                let mut acc = [0.0; 14];
+                for &(ci, cj, wt) in &corners {
+                    if wt == 0.0 {
+                        continue;
+                    }
+                    let node_roll = self.r0 + cj as f64 * self.dr;
+                    let m = &nodes[ci * self.nr + cj][slot];
+                    let mut v = to_array(m);
+                    // Side-local wheel point (ξ, ζ): the gap's rigid-body roll
+                    // dependence sin φ·ξ + (cos φ − 1)·ζ is interpolated out.
+                    let (xi, zeta) = (sign * m.wheel_y, m.wheel_z);
+                    v[0] -= node_roll.sin() * xi + (node_roll.cos() - 1.0) * zeta;
+                    for (a, v) in acc.iter_mut().zip(v) {
+                        *a += wt * v;
+                    }
+                }
+                let mut c = from_array(acc);
+                c.gap = gap + ps.sin() * sign * c.wheel_y + (ps.cos() - 1.0) * c.wheel_z;
+                // ∂gap/∂y_s = −tan δ (moving the wheel outwards onto a surface
+                // inclined by δ closes the gap by tan δ per metre).
+                c.contact_angle = (-slope).atan();
+                out[side][slot] = c;
+            }
+        }
+        Ok(out)
+    }
+
     pub fn lookup(&self, y: f64, roll: f64) -> Result<[ContactSet; 2], GeometryError> {
         let (i, ty) = Self::locate("lateral shift", y, self.y0, self.dy, self.ny)?;
         let (j, tr) = Self::locate("roll", roll, self.r0, self.dr, self.nr)?;
@@ -981,6 +1192,25 @@ impl ContactTable {
         }
         Ok(out)
     }
+}
+
+/// The tread/flange split of one side from the rigid contact sweep (see
+/// [`ContactTable::region_split`]).
+fn region_split(rigid: &[RigidContact], side: usize) -> f64 {
+    let mut split = f64::NEG_INFINITY;
+    let mut largest = 0.0;
+    for w in rigid.windows(2) {
+        let (a, b) = (w[0].sides[side].deepest(), w[1].sides[side].deepest());
+        // A jump of the contact point (more than 2 mm on the wheel) that
+        // turns the normal the most: the flange-root fold rather than a
+        // jump between two tread points.
+        let turn = (a.contact_angle.tan() - b.contact_angle.tan()).abs();
+        if (a.wheel_u - b.wheel_u).abs() > 2e-3 && turn > largest {
+            largest = turn;
+            split = 0.5 * (a.wheel_u + b.wheel_u);
+        }
+    }
+    split
 }
 
 fn to_array(c: &Contact) -> [f64; 14] {

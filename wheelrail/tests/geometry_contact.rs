@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use railmbs_wheelrail::conicity::{RollTreatment, RollingRadiusDifference, conicity_curve};
 use railmbs_wheelrail::geometry::{
-    ContactGeometry, ContactTable, GeometryError, SearchSettings, TableSettings, Track, Wheelset,
+    Contact, ContactGeometry, ContactTable, GeometryError, SearchSettings, TableSettings, Track,
+    Wheelset,
 };
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfilePoints, ProfileSettings};
 
@@ -358,4 +359,61 @@ fn yaw_lead_matches_three_dimensional_minimum_distance() {
             "ψ {psi}: 3-D {x} vs k ψ {predicted}"
         );
     }
+}
+
+#[test]
+fn region_lookup_is_accurate_and_continuous_across_the_flange_root_jump() {
+    // S1002 on UIC60 1:40: the single contact point jumps from the flange
+    // root (δ ≈ 0.6) to the flange (δ ≈ 1.2) near y = 6.3 mm. The region
+    // table must (a) equal the direct region search between nodes to a few
+    // µm in gap (about 1 µm where the gap is smooth; up to 10 µm where a
+    // slot's minimum passes from the region's boundary into its interior, a
+    // kink of the gap that the cubic interpolation rounds off over one
+    // 0.1 mm cell) and (b) never jump: between samples
+    // 2 µm apart the gap of each slot changes by at most the distance
+    // function's slope (|∂gap/∂y| ≤ tan 1.25 ≈ 3) times the step.
+    let (ws, tr) = s1002_uic60();
+    let geo = ContactGeometry::new(&ws, &tr, SearchSettings::default()).unwrap();
+    let table = ContactTable::from_geometry(
+        &geo,
+        TableSettings {
+            y_max: 0.009,
+            dy: 0.1e-3,
+            roll_max: 0.004,
+            droll: 2e-3,
+        },
+    )
+    .unwrap();
+    let split = table.region_split();
+    let roll = 0.7e-3; // between roll nodes
+    let mut prev: Option<[[Contact; 2]; 2]> = None;
+    let mut worst: f64 = 0.0;
+    let dy = 2e-6;
+    for k in 0..1000 {
+        let y = 5.5e-3 + k as f64 * dy;
+        let t = table.lookup_regions(y, roll).unwrap();
+        if k % 50 == 0 {
+            for side in 0..2 {
+                let d = geo.region_contacts(side, y, roll, split[side]).unwrap();
+                for slot in 0..2 {
+                    worst = worst.max((t[side][slot].gap - d[slot].gap).abs());
+                }
+            }
+        }
+        if let Some(p) = prev {
+            for side in 0..2 {
+                for slot in 0..2 {
+                    let jump = (t[side][slot].gap - p[side][slot].gap).abs();
+                    assert!(jump <= 3.0 * dy, "gap jumps by {jump:e} m at y = {y}");
+                }
+            }
+        }
+        prev = Some(t);
+    }
+    assert!(worst < 10e-6, "table vs direct region search: {worst:e} m");
+    // The deepest slot is the direct search's single contact at the nodes.
+    let d = geo.contacts(6.0e-3, 0.0).unwrap();
+    let t = table.lookup_regions(6.0e-3, 0.0).unwrap();
+    let deepest = t[0][0].gap.min(t[0][1].gap);
+    assert!((deepest - d[0].deepest().gap).abs() < 1e-9);
 }

@@ -11,8 +11,13 @@
 //!    shifted rigidly, laterally by Δyₖ and vertically by Δzₖ, so wheel k sees
 //!    the wheelset at lateral shift y − Δyₖ over a nominal rail and its gap
 //!    grows by z − r₀ − Δzₖ;
-//! 3. the contacts of each wheel from the contact table (one- or two-point
-//!    contact, [`railmbs_wheelrail::geometry`]): vertical penetration p = −gap,
+//! 3. the contacts of each wheel from the contact table: the deepest point of
+//!    the tread region and of the flange region of the wheel profile
+//!    ([`railmbs_wheelrail::geometry::ContactTable::lookup_regions`]), so one-
+//!    and two-point contact come out of one continuous description (the
+//!    single deepest point jumps at the flange root of S1002 on UIC60, which
+//!    would make the forces jump and the integration chatter); the contact
+//!    angle is the gap's lateral slope. Vertical penetration p = −gap,
 //!    normal approach δ = p cos δ_c (δ_c the contact angle), Hertzian normal
 //!    force N = (δ/δ₁)^{3/2} (plus optional damping along the normal, never
 //!    pulling);
@@ -41,9 +46,7 @@ use railmbs_track::{SpeedLaw, Track};
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
 };
-use railmbs_wheelrail::geometry::{
-    self, Contact, ContactSet, ContactTable, SearchSettings, TableSettings,
-};
+use railmbs_wheelrail::geometry::{self, Contact, ContactTable, SearchSettings, TableSettings};
 use railmbs_wheelrail::hertz::{HertzShape, effective_modulus, wheel_rail_curvatures};
 use railmbs_wheelrail::kalker::KalkerCoefficients;
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
@@ -349,7 +352,7 @@ impl WheelRailContact {
         ];
         let table = &b.contact.table;
         let lookup = |y: f64| {
-            table.lookup(y, roll).map_err(|e| {
+            table.lookup_regions(y, roll).map_err(|e| {
                 self.diverged(
                     t,
                     format!(
@@ -367,7 +370,7 @@ impl WheelRailContact {
         } else {
             lookup(rel.y - rail_shift[1].0)?
         };
-        let sets: [&ContactSet; 2] = [&left_sets[0], &right_sets[1]];
+        let sets: [&[Contact; 2]; 2] = [&left_sets[0], &right_sets[1]];
         let z_geom = rel.z - b.contact.nominal_radius;
         let mut state = WheelsetState {
             track_axes: axes,
@@ -377,7 +380,7 @@ impl WheelRailContact {
         for side in 0..2 {
             let (dy, dz) = rail_shift[side];
             let sign = if side == 0 { 1.0 } else { -1.0 };
-            for c in sets[side].as_slice() {
+            for c in sets[side] {
                 let penetration = -(c.gap + z_geom - dz);
                 if penetration <= 0.0 {
                     continue;
