@@ -108,6 +108,9 @@ pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState
 /// Column layout of the output file.
 struct Columns {
     header: Vec<String>,
+    /// The running speed law, when the run is on a track: the column `s[m]`
+    /// (arc position of the vehicle's reference point) follows `time`.
+    arc: Option<RunningSpeed>,
     coordinates: bool,
     velocities: bool,
     bodies: Vec<usize>,
@@ -144,8 +147,12 @@ fn columns(
     system: &ModelSystem,
     spec: &OutputSpec,
     file: &Path,
+    arc: Option<RunningSpeed>,
 ) -> Result<Columns, RunError> {
     let mut header = vec!["time".to_string()];
+    if arc.is_some() {
+        header.push("s[m]".to_string());
+    }
     if spec.coordinates {
         header.extend(model.coordinates.iter().map(|c| c.name.clone()));
     }
@@ -190,6 +197,7 @@ fn columns(
     }
     Ok(Columns {
         header,
+        arc,
         coordinates: spec.coordinates,
         velocities: spec.velocities,
         need_kinematics: !bodies.is_empty() || !forces.is_empty(),
@@ -426,6 +434,13 @@ impl Recorder {
         let cols = &self.columns;
         self.values.clear();
         self.values.push(t);
+        if let Some(arc) = &cols.arc {
+            use railmbs_track::SpeedLaw;
+            let s = arc
+                .motion(t)
+                .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))?;
+            self.values.push(s.s);
+        }
         if cols.coordinates {
             self.values.extend_from_slice(q);
         }
@@ -503,7 +518,8 @@ pub fn run_scenario(
             }
         }
     }
-    let columns = columns(model, &system, &scenario.output, &scenario.source)?;
+    let arc = binding.as_ref().map(|b| b.speed.clone());
+    let columns = columns(model, &system, &scenario.output, &scenario.source, arc)?;
     let writer = match output {
         Some(p) => {
             if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
