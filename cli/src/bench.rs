@@ -123,6 +123,41 @@ pub struct Args {
     /// Number of random states the evaluations cycle through.
     #[arg(long, default_value_t = 16)]
     pub states: usize,
+    /// Creep-force law of every wheel–rail element, overriding the model's:
+    /// `fastsim-a[:STRIPS]`, `fastsim:N` (N × N elements), `kalker` or
+    /// `mueller`.
+    #[arg(long)]
+    pub creep: Option<String>,
+}
+
+/// Parses `--creep`.
+pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
+    use railmbs_models::{CreepLawKind, Expr};
+    let (name, n) = match text.split_once(':') {
+        Some((a, b)) => (
+            a,
+            Some(b.parse::<usize>().ok().filter(|&n| n > 0).ok_or_else(|| {
+                format!("--creep {text}: \"{b}\" is not a positive number of strips/elements")
+            })?),
+        ),
+        None => (text, None),
+    };
+    match (name, n) {
+        ("fastsim-a", n) => Ok(CreepLawKind::FastsimA {
+            strips: n.unwrap_or(20),
+        }),
+        ("fastsim", n) => {
+            let n = n.unwrap_or(10);
+            Ok(CreepLawKind::Fastsim { nx: n, ny: n })
+        }
+        ("kalker", None) => Ok(CreepLawKind::Kalker),
+        ("mueller", None) => Ok(CreepLawKind::Mueller {
+            exponent: Expr::Num(2.0),
+        }),
+        _ => Err(format!(
+            "--creep {text}: expected fastsim-a[:STRIPS], fastsim[:N], kalker or mueller"
+        )),
+    }
 }
 
 /// The measurements of one engine.
@@ -134,6 +169,8 @@ pub struct EngineTimes {
     pub dynamics_ns: Option<f64>,
     /// Scenario run (`run_scenario` without CSV output), s.
     pub run_s: Option<f64>,
+    /// Integration steps of the scenario run.
+    pub run_steps: Option<usize>,
     /// Why something is missing.
     pub note: Option<String>,
 }
@@ -155,6 +192,8 @@ pub struct BenchReport {
     pub derive_s: Option<f64>,
     /// Plugin build beyond derivation and emission (compilation or cache), s.
     pub compile_s: Option<f64>,
+    /// The `--creep` override, if any.
+    pub creep: Option<String>,
 }
 
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
@@ -197,6 +236,9 @@ impl BenchReport {
             "numeric_run_s": self.numeric.run_s,
             "symbolic_run_s": self.symbolic.run_s,
             "run_ratio": self.run_ratio(),
+            "numeric_run_steps": self.numeric.run_steps,
+            "symbolic_run_steps": self.symbolic.run_steps,
+            "creep": self.creep,
             "derive_s": self.derive_s,
             "compile_s": self.compile_s,
             "numeric_note": self.numeric.note,
@@ -220,6 +262,9 @@ impl BenchReport {
         match (&self.scenario, &self.scenario_note) {
             (Some(p), _) => {
                 let _ = writeln!(s, "scenario {}", p.display());
+                if let Some(c) = &self.creep {
+                    let _ = writeln!(s, "creep law of every wheel–rail element: {c}");
+                }
             }
             (None, Some(n)) => {
                 let _ = writeln!(s, "scenario: none ({n})");
@@ -229,6 +274,10 @@ impl BenchReport {
         let ns = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.1} ns"));
         let sec = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4} s"));
         let r = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
+        let per_step = |t: Option<f64>, n: Option<usize>| match (t, n) {
+            (Some(t), Some(n)) if n > 0 => format!("{:.1} µs", 1e6 * t / n as f64),
+            _ => "-".to_string(),
+        };
         let _ = writeln!(
             s,
             "{:<28} {:>14} {:>14} {:>18}",
@@ -253,9 +302,28 @@ impl BenchReport {
                 sec(self.symbolic.run_s),
                 r(self.run_ratio()),
             ),
+            (
+                "steps of the run",
+                self.numeric.run_steps.map_or("-".into(), |n| n.to_string()),
+                self.symbolic.run_steps.map_or("-".into(), |n| n.to_string()),
+                String::new(),
+            ),
+            (
+                "CPU time per step",
+                per_step(self.numeric.run_s, self.numeric.run_steps),
+                per_step(self.symbolic.run_s, self.symbolic.run_steps),
+                String::new(),
+            ),
         ];
         for (label, a, b, c) in rows {
             let _ = writeln!(s, "{label:<28} {a:>14} {b:>14} {c:>18}");
+        }
+        if self.numeric.dynamics_ns.is_none() && self.numeric.eval_ns.is_some() {
+            let _ = writeln!(
+                s,
+                "dynamics: not timed alone for a model on the track (its wheel–rail forces \
+                 need the scenario's track); the scenario run includes it"
+            );
         }
         let _ = writeln!(
             s,
@@ -341,15 +409,24 @@ pub fn time_per_call<E>(mut f: impl FnMut(usize) -> Result<(), E>) -> Result<f64
 }
 
 /// Times (M, k) and `dynamics` of `equations` (and of a second, identical
-/// engine for the system) on `states`.
+/// engine for the system) on `states`. Models on track-following frames get
+/// random frame inputs for (M, k); their `dynamics` needs the scenario's track
+/// (wheel–rail elements) and is measured by the scenario run instead (`None`).
 fn time_engine(
     model: &Model,
     params: &[f64],
     states: &[State],
     make: &dyn Fn() -> Result<Box<dyn Equations>, String>,
-) -> Result<(f64, f64), String> {
+) -> Result<(f64, Option<f64>), String> {
     let mut eng = make()?;
     eng.set_parameters(params).map_err(|e| e.to_string())?;
+    if eng.input_count() > 0 {
+        let mut rng = Rng::new(7);
+        let u: Vec<f64> = (0..3 * eng.input_count())
+            .map(|_| rng.uniform(-1.0, 1.0))
+            .collect();
+        eng.set_inputs(&u).map_err(|e| e.to_string())?;
+    }
     let mut out = Evaluation::for_equations(eng.as_ref());
     let n = states.len();
     let eval_ns = time_per_call(|k| {
@@ -359,6 +436,9 @@ fn time_engine(
         std::hint::black_box(&out.mass);
         Ok::<(), String>(())
     })?;
+    if !model.track_frames.is_empty() {
+        return Ok((eval_ns, None));
+    }
     let mut system =
         ModelSystem::new(model, make()?, params.to_vec()).map_err(|e| e.to_string())?;
     let dof = system.dof();
@@ -372,15 +452,17 @@ fn time_engine(
         std::hint::black_box(&force);
         Ok::<(), String>(())
     })?;
-    Ok((eval_ns, dynamics_ns))
+    Ok((eval_ns, Some(dynamics_ns)))
 }
 
-/// Median time of `run_scenario` (no CSV output) with engines from `make`, s.
+/// Median time of `run_scenario` (no CSV output) with engines from `make`, s,
+/// and the number of steps of a run.
 fn time_run(
     scenario: &Scenario,
     model: &Model,
     make: &dyn Fn() -> Result<Box<dyn Equations>, String>,
-) -> Result<f64, String> {
+) -> Result<(f64, usize), String> {
+    let mut steps = 0;
     let mut times = Vec::new();
     let mut total = 0.0;
     while times.len() < MAX_RUNS && (times.is_empty() || total < RUN_SECONDS) {
@@ -394,11 +476,12 @@ fn time_run(
         if let Some(e) = summary.error {
             return Err(format!("the scenario run failed: {e}"));
         }
+        steps = summary.steps;
         total += seconds;
         times.push(seconds);
     }
     times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
+    Ok((times[times.len() / 2], steps))
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -464,7 +547,20 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
     if args.states == 0 {
         return Err("--states must be at least 1".into());
     }
-    let model = railmbs_models::load_model(&args.model)?;
+    let mut model = railmbs_models::load_model(&args.model)?;
+    if let Some(text) = &args.creep {
+        let law = parse_creep(text)?;
+        let mut found = false;
+        for f in &mut model.forces {
+            if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {
+                w.creep = law.clone();
+                found = true;
+            }
+        }
+        if !found {
+            return Err(format!("--creep: model {} has no wheel–rail element", args.model.display()).into());
+        }
+    }
     let (scenario, scenario_note) = match &args.scenario {
         Some(p) => {
             let s = railmbs_models::load_scenario(p)?;
@@ -500,13 +596,16 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
     match time_engine(&model, &params, &states, &numeric_make) {
         Ok((e, d)) => {
             numeric.eval_ns = Some(e);
-            numeric.dynamics_ns = Some(d);
+            numeric.dynamics_ns = d;
         }
         Err(e) => numeric.note = Some(e),
     }
     if let Some(s) = &scenario {
         match time_run(s, &model, &numeric_make) {
-            Ok(t) => numeric.run_s = Some(t),
+            Ok((t, n)) => {
+                numeric.run_s = Some(t);
+                numeric.run_steps = Some(n);
+            }
             Err(e) => numeric.note = Some(e),
         }
     }
@@ -535,13 +634,16 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
                 match time_engine(&model, &params, &states, &make) {
                     Ok((e, dy)) => {
                         symbolic.eval_ns = Some(e);
-                        symbolic.dynamics_ns = Some(dy);
+                        symbolic.dynamics_ns = dy;
                     }
                     Err(e) => symbolic.note = Some(e),
                 }
                 if let Some(s) = &scenario {
                     match time_run(s, &model, &make) {
-                        Ok(t) => symbolic.run_s = Some(t),
+                        Ok((t, n)) => {
+                            symbolic.run_s = Some(t);
+                            symbolic.run_steps = Some(n);
+                        }
                         Err(e) => symbolic.note = Some(e),
                     }
                 }
@@ -561,6 +663,7 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
         symbolic,
         derive_s,
         compile_s,
+        creep: args.creep.clone(),
     })
 }
 
