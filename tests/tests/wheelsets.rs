@@ -118,3 +118,156 @@ fn free_wheelset_runs_klingels_kinematic_oscillation() {
     );
     assert!(err < 0.03, "wavelength error {:.2} %", 100.0 * err);
 }
+
+/// Mass of Manchester Vehicle 1 carried by its wheels (car body, two bogie
+/// frames, four wheelsets), kg.
+const VEHICLE1_MASS: f64 = 32000.0 + 2.0 * 2615.0 + 4.0 * 1813.0;
+
+/// Runs Vehicle 1 through the 1200 m curve with 150 mm cant at `speed` and
+/// returns the means over the car body's arc positions 500–800 m (whole
+/// vehicle in the circular curve) of the total track-shifting force ΣY (N,
+/// positive to the left) and of the left and right wheel loads (N).
+fn vehicle1_in_the_1200_m_curve(speed: f64) -> (f64, f64, f64) {
+    let mut scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/vehicle1_curve_1200.ron")).unwrap();
+    let track = scenario.track.as_mut().unwrap();
+    track.speed = speed;
+    scenario.parameters = vec![("v0".into(), format!("{speed:?}"))];
+    scenario.end_time = (800.0 - track.start) / speed + 0.1;
+    scenario.output.interval = 0.05;
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let summary = railmbs_runtime::simulate::run_scenario(
+        &scenario,
+        &model,
+        Box::new(NumericEquations::new(&model)),
+        Some(&out),
+        |_| {},
+    )
+    .unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    let t = Table::read(&out);
+    let s = t.col("s[m]");
+    let sum = |name: &str| -> Vec<f64> {
+        let mut acc = vec![0.0; s.len()];
+        for b in 1..=2 {
+            for w in 1..=2 {
+                for (a, v) in acc
+                    .iter_mut()
+                    .zip(t.col(&format!("Bogie{b}.WS{w}.contact.{name}")))
+                {
+                    *a += v;
+                }
+            }
+        }
+        acc
+    };
+    let window: Vec<usize> = (0..s.len())
+        .filter(|&i| (500.0..=800.0).contains(&s[i]))
+        .collect();
+    assert!(window.len() > 20);
+    let mean = |v: &[f64]| window.iter().map(|&i| v[i]).sum::<f64>() / window.len() as f64;
+    (
+        mean(&sum("SumY [N]")),
+        mean(&sum("L.Q [N]")),
+        mean(&sum("R.Q [N]")),
+    )
+}
+
+/// Steady curving at the balancing speed v = √(g R tan φ) of the 1200 m
+/// curve with 150 mm cant: the resultant of gravity and centrifugal force is
+/// normal to the track plane, so the vehicle's total lateral force on the
+/// track vanishes and the left and right wheel loads are equal. Tolerances:
+/// 1 % of the vehicle's weight component m g sin φ for ΣY (the curving
+/// wheelsets' creep forces are internal); 5 % for the loads: to steer, the
+/// wheelsets run up to 3 mm towards the outer rail, where S1002 on UIC60
+/// 1:40 moves the contact points asymmetrically (0.757 m and −0.740 m from
+/// the track centre instead of ±0.753 m), so each wheelset's moment balance
+/// puts about 3 % more load on the outer wheel; the simulation gives 3.5 %.
+#[test]
+fn vehicle1_at_the_balancing_speed_loads_both_rails_equally() {
+    let (g, radius, cant, e2): (f64, f64, f64, f64) = (9.81, 1200.0, 0.150, 1.5);
+    let phi = (cant / e2).asin();
+    let speed = (g * radius * phi.tan()).sqrt();
+    let (sum_y, ql, qr) = vehicle1_in_the_1200_m_curve(speed);
+    let weight_in_plane = VEHICLE1_MASS * g * phi.sin();
+    println!("v = {speed:.2} m/s: ΣY {sum_y:.0} N, Q left {ql:.0} N, right {qr:.0} N");
+    assert!(sum_y.abs() < 0.01 * weight_in_plane, "ΣY {sum_y} N");
+    assert!(
+        (ql - qr).abs() < 0.05 * 0.5 * (ql + qr),
+        "loads {ql} / {qr} N"
+    );
+}
+
+/// Steady curving with cant deficiency (45 m/s in the same curve): the total
+/// lateral force of the wheels on the track equals the vehicle's mass times
+/// the uncompensated acceleration in the track plane,
+/// m (v²/R cos φ − g sin φ) (outwards, to the right in this left curve), and
+/// the total wheel load m (g cos φ + v²/R sin φ). Tolerance 1 % (suspension
+/// and creep forces are internal; what remains is the quasi-static state's
+/// residual motion).
+#[test]
+fn vehicle1_with_cant_deficiency_pushes_the_track_by_m_times_the_uncompensated_acceleration() {
+    let (g, radius, cant, e2, speed): (f64, f64, f64, f64, f64) = (9.81, 1200.0, 0.150, 1.5, 45.0);
+    let phi = (cant / e2).asin();
+    let (sum_y, ql, qr) = vehicle1_in_the_1200_m_curve(speed);
+    let centripetal = speed * speed / radius;
+    let lateral = -VEHICLE1_MASS * (centripetal * phi.cos() - g * phi.sin());
+    let normal = VEHICLE1_MASS * (g * phi.cos() + centripetal * phi.sin());
+    println!(
+        "ΣY {sum_y:.0} N (expected {lateral:.0}), ΣQ {:.0} N (expected {normal:.0})",
+        ql + qr
+    );
+    assert!(
+        (sum_y - lateral).abs() < 0.01 * lateral.abs(),
+        "ΣY {sum_y} vs {lateral} N"
+    );
+    assert!(
+        (ql + qr - normal).abs() < 0.01 * normal,
+        "ΣQ {} vs {normal} N",
+        ql + qr
+    );
+    assert!(qr > ql, "the outer (right) wheels carry more");
+}
+
+/// A symmetric vehicle started centred on perfect straight track stays
+/// centred: no lateral motion appears from nothing (left/right symmetry of
+/// the model, the contact table and the creep forces).
+#[test]
+fn vehicle1_on_perfect_straight_track_stays_centred() {
+    let mut scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/vehicle1_tc1.ron")).unwrap();
+    let track = scenario.track.as_mut().unwrap();
+    track.file = model_path("tracks/straight.ron");
+    track.speed = 30.0;
+    scenario.parameters = vec![("v0".into(), "30.0".into())];
+    scenario.end_time = 3.0;
+    scenario.output.coordinates = true;
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let summary = railmbs_runtime::simulate::run_scenario(
+        &scenario,
+        &model,
+        Box::new(NumericEquations::new(&model)),
+        Some(&out),
+        |_| {},
+    )
+    .unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    let t = Table::read(&out);
+    let mut worst: f64 = 0.0;
+    for c in model
+        .coordinates
+        .iter()
+        .filter(|c| c.name.ends_with(".y") || c.name.ends_with(".rz"))
+    {
+        worst = t.col(&c.name).iter().fold(worst, |m, v| m.max(v.abs()));
+    }
+    // Rounding only: lateral displacements and yaw below 1e-9 (m, rad).
+    assert!(
+        worst < 1e-9,
+        "largest lateral displacement or yaw {worst:e}"
+    );
+}
