@@ -8,5 +8,6 @@ pub mod bench;
 pub mod conicity;
 pub mod creep;
 pub mod engine;
+pub mod plot;
 pub mod run;
 pub mod umgen;

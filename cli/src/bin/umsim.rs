@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, run};
+use railmbs_cli::{bench, conicity, creep, plot, run};
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +24,8 @@ enum Command {
     Conicity(conicity::Args),
     /// Creep forces for a table of contact cases.
     Creep(creep::Args),
+    /// Plot output columns against time or distance (SVG or PNG).
+    Plot(plot::Args),
 }
 
 fn main() {
@@ -33,6 +35,7 @@ fn main() {
         Command::Bench(a) => bench::run(a),
         Command::Conicity(a) => conicity::run(a),
         Command::Creep(a) => creep::run(a),
+        Command::Plot(a) => plot::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");
