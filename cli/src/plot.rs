@@ -389,12 +389,16 @@ pub fn read_table<R: std::io::Read>(
     Ok((header, xi, panels, table))
 }
 
-/// An axis range holding `lo..hi` with a small margin; a single value gets a
-/// range of ±10 % of it (±1 around zero).
+/// The largest axis bound: ranges stay finite (plotters loops on infinite ones).
+const LIMIT: f64 = f64::MAX / 4.0;
+
+/// An axis range holding `lo..hi` (within ±`LIMIT`) with a small margin; a
+/// single value gets a range of ±10 % of it (±1 around zero).
 pub fn padded_range(lo: f64, hi: f64) -> (f64, f64) {
     if !(lo.is_finite() && hi.is_finite()) || lo > hi {
         return (-1.0, 1.0);
     }
+    let (lo, hi) = (lo.max(-LIMIT), hi.min(LIMIT));
     let span = hi - lo;
     let scale = lo.abs().max(hi.abs());
     if span <= scale * 1e-12 {
@@ -771,7 +775,13 @@ fn register_font() -> Result<(), String> {
 /// Runs `umsim plot`.
 pub fn run(args: &Args) -> Result<(), Box<dyn Error>> {
     let format = Format::of(&args.output)?;
-    if let (Some(f), Some(t)) = (args.from, args.to)
+    if args.from.is_some_and(f64::is_nan) || args.to.is_some_and(f64::is_nan) {
+        return Err("--from and --to must be numbers, not NaN".into());
+    }
+    // An infinite bound on its own side is no bound.
+    let from = args.from.filter(|f| *f != f64::NEG_INFINITY);
+    let to = args.to.filter(|t| *t != f64::INFINITY);
+    if let (Some(f), Some(t)) = (from, to)
         && f > t
     {
         return Err(format!("--from {f} is beyond --to {t}").into());
@@ -798,12 +808,13 @@ pub fn run(args: &Args) -> Result<(), Box<dyn Error>> {
         &source,
         &args.x,
         &args.y,
-        args.from,
-        args.to,
+        from,
+        to,
     )?;
     let (lo, hi) = finite_bounds(table.x.iter()).expect("read_table keeps finite x only");
     let x_range = {
-        let (lo, hi) = (args.from.unwrap_or(lo), args.to.unwrap_or(hi));
+        let lo = from.unwrap_or(lo).max(-LIMIT);
+        let hi = to.unwrap_or(hi).min(LIMIT);
         if hi > lo {
             (lo, hi)
         } else {
@@ -923,6 +934,8 @@ mod tests {
         assert!((a - 1.8).abs() < 1e-12 && (b - 2.2).abs() < 1e-12);
         let (a, b) = padded_range(0.0, 10.0);
         assert!((a + 0.5).abs() < 1e-12 && (b - 10.5).abs() < 1e-12);
+        let (a, b) = padded_range(-f64::MAX, f64::MAX);
+        assert!((b - a).is_finite() && a < -1e307 && b > 1e307);
     }
 
     #[test]
