@@ -26,7 +26,10 @@ pub struct Args {
 
 /// Runs `umsim run`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let scenario = railmbs_models::load_scenario(&args.scenario)?;
+    let scenario = match railmbs_models::load_any_scenario(&args.scenario)? {
+        railmbs_models::AnyScenario::Single(s) => s,
+        railmbs_models::AnyScenario::Train(t) => return run_train(args, &t),
+    };
     let model = railmbs_models::load_model(&scenario.model)?;
     let engine = if args.plugin.is_some() {
         Engine::Symbolic
@@ -36,18 +39,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let equations = build_engine(&model, engine, args.plugin.as_deref())?;
     let output = args.output.clone().or_else(|| scenario.output_file.clone());
 
-    let bar = if !args.quiet && std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} t = {msg} s",
-            )
-            .expect("valid progress template"),
-        );
-        Some(bar)
-    } else {
-        None
-    };
+    let bar = progress_bar(args);
     let t_end = scenario.end_time;
     let summary = run_scenario(&scenario, &model, equations, output.as_deref(), |t| {
         if let Some(b) = &bar {
@@ -55,6 +47,90 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             b.set_message(format!("{t:.3}"));
         }
     })?;
+    finish(args, bar, summary, output)
+}
+
+/// A progress bar on a terminal unless `--quiet`.
+fn progress_bar(args: &Args) -> Option<indicatif::ProgressBar> {
+    if args.quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} t = {msg} s",
+        )
+        .expect("valid progress template"),
+    );
+    Some(bar)
+}
+
+/// `umsim run` of a train file: one engine per vehicle; the symbolic engine
+/// builds (or loads) one plugin per distinct model file, shared by identical
+/// vehicles. `--plugin` serves trains whose vehicles all use one model.
+fn run_train(
+    args: &Args,
+    train: &railmbs_models::TrainScenario,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let engine = if args.plugin.is_some() {
+        Engine::Symbolic
+    } else {
+        args.engine
+    };
+    // Distinct model files, loaded (and compiled) once each.
+    let mut files: Vec<(PathBuf, railmbs_models::Model, Option<PathBuf>)> = Vec::new();
+    let mut which = Vec::new();
+    for v in &train.vehicles {
+        let k = match files.iter().position(|(p, _, _)| p == &v.model) {
+            Some(k) => k,
+            None => {
+                let model = railmbs_models::load_model(&v.model)?;
+                let plugin = match (engine, &args.plugin) {
+                    (Engine::Numeric, _) => None,
+                    (Engine::Symbolic, Some(p)) => Some(p.clone()),
+                    (Engine::Symbolic, None) => Some(crate::engine::build_symbolic(&model)?.path),
+                };
+                files.push((v.model.clone(), model, plugin));
+                files.len() - 1
+            }
+        };
+        which.push(k);
+    }
+    if args.plugin.is_some() && files.len() > 1 {
+        return Err(format!(
+            "--plugin serves one model, but the train {} uses {} model files; \
+             leave it out to build each model's plugin",
+            args.scenario.display(),
+            files.len()
+        )
+        .into());
+    }
+    let models: Vec<&railmbs_models::Model> = which.iter().map(|&k| &files[k].1).collect();
+    let engines = which
+        .iter()
+        .map(|&k| build_engine(&files[k].1, engine, files[k].2.as_deref()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let output = args.output.clone().or_else(|| train.output_file.clone());
+    let bar = progress_bar(args);
+    let t_end = train.end_time;
+    let summary =
+        railmbs_runtime::train::run_train(train, &models, engines, output.as_deref(), |t| {
+            if let Some(b) = &bar {
+                b.set_position((1000.0 * t / t_end) as u64);
+                b.set_message(format!("{t:.3}"));
+            }
+        })?;
+    finish(args, bar, summary, output)
+}
+
+/// Clears the progress bar, prints the summary, turns a simulation error
+/// into the command's error.
+fn finish(
+    args: &Args,
+    bar: Option<indicatif::ProgressBar>,
+    summary: RunSummary,
+    output: Option<PathBuf>,
+) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }

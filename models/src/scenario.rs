@@ -225,16 +225,92 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             });
         }
     };
+    let Common {
+        integrator,
+        output,
+        track,
+        parameters,
+    } = common(
+        raw.end_time,
+        raw.integrator,
+        raw.output,
+        raw.track,
+        raw.parameters,
+        path,
+        &mut check,
+    );
+    for init in &raw.initial {
+        for (what, x) in [("value", init.value), ("velocity", init.velocity)] {
+            if let Some(x) = x {
+                check(
+                    x.is_finite(),
+                    what,
+                    format!("initial {what} of \"{}\" is not finite: {x}", init.coord),
+                );
+            }
+        }
+        check(
+            init.value.is_some() || init.velocity.is_some(),
+            "initial",
+            format!(
+                "initial condition of \"{}\" sets neither value nor velocity",
+                init.coord
+            ),
+        );
+    }
+    if !errors.is_empty() {
+        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        return Err(ModelErrors(errors));
+    }
+    let dir = path.parent().unwrap_or(Path::new(""));
+    Ok(Scenario {
+        source: path.to_path_buf(),
+        model: dir.join(&raw.model),
+        macros: raw.macros,
+        parameters,
+        initial: raw
+            .initial
+            .into_iter()
+            .map(|i| InitialOverride {
+                coordinate: i.coord,
+                value: i.value,
+                velocity: i.velocity,
+            })
+            .collect(),
+        end_time: raw.end_time,
+        integrator,
+        output,
+        output_file: raw.output_file.map(|f| dir.join(f)),
+        track,
+    })
+}
+
+/// What a single-vehicle scenario and a train share, validated.
+struct Common {
+    integrator: IntegratorSpec,
+    output: OutputSpec,
+    track: Option<ScenarioTrack>,
+    parameters: Vec<(String, String)>,
+}
+
+/// Validates the parts common to `Scenario` and `Train` files (`check`
+/// records an error at the first `key:` of the file when `ok` is false).
+fn common(
+    end_time: f64,
+    raw_integrator: RawIntegrator,
+    raw_output: RawOutput,
+    raw_track: Option<RawTrack>,
+    raw_parameters: OrderedMap<Value>,
+    path: &Path,
+    check: &mut dyn FnMut(bool, &str, String),
+) -> Common {
     let positive = |x: f64| x.is_finite() && x > 0.0;
     check(
-        positive(raw.end_time),
+        positive(end_time),
         "end_time",
-        format!(
-            "end_time must be positive and finite, got {} s",
-            raw.end_time
-        ),
+        format!("end_time must be positive and finite, got {} s", end_time),
     );
-    let integrator = match raw.integrator {
+    let integrator = match raw_integrator {
         RawIntegrator::Rk4 { step } => {
             check(
                 positive(step),
@@ -282,33 +358,14 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
         }
     };
     check(
-        positive(raw.output.interval),
+        positive(raw_output.interval),
         "interval",
         format!(
             "output interval must be positive and finite, got {} s",
-            raw.output.interval
+            raw_output.interval
         ),
     );
-    for init in &raw.initial {
-        for (what, x) in [("value", init.value), ("velocity", init.velocity)] {
-            if let Some(x) = x {
-                check(
-                    x.is_finite(),
-                    what,
-                    format!("initial {what} of \"{}\" is not finite: {x}", init.coord),
-                );
-            }
-        }
-        check(
-            init.value.is_some() || init.velocity.is_some(),
-            "initial",
-            format!(
-                "initial condition of \"{}\" sets neither value nor velocity",
-                init.coord
-            ),
-        );
-    }
-    let track = raw.track.map(|t| {
+    let track = raw_track.map(|t| {
         let profile_speed = t.speed_profile.first().map(|k| k.1);
         check(
             t.speed.is_some() != profile_speed.is_some(),
@@ -355,8 +412,29 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
             speed_profile: t.speed_profile,
         }
     });
+    let parameters = overrides(raw_parameters, check);
+    Common {
+        integrator,
+        output: OutputSpec {
+            interval: raw_output.interval,
+            coordinates: raw_output.coordinates,
+            velocities: raw_output.velocities,
+            bodies: raw_output.bodies,
+            forces: raw_output.forces,
+        },
+        track,
+        parameters,
+    }
+}
+
+/// Parameter overrides as (name, expression text); a RON number is stored as
+/// its text.
+fn overrides(
+    raw_parameters: OrderedMap<Value>,
+    check: &mut dyn FnMut(bool, &str, String),
+) -> Vec<(String, String)> {
     let mut parameters: Vec<(String, String)> = Vec::new();
-    for (name, v) in raw.parameters.0 {
+    for (name, v) in raw_parameters.0 {
         check(
             !parameters.iter().any(|(n, _)| n == &name),
             "parameters",
@@ -375,37 +453,7 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
         };
         parameters.push((name, text));
     }
-    if !errors.is_empty() {
-        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
-        return Err(ModelErrors(errors));
-    }
-    let dir = path.parent().unwrap_or(Path::new(""));
-    Ok(Scenario {
-        source: path.to_path_buf(),
-        model: dir.join(&raw.model),
-        macros: raw.macros,
-        parameters,
-        initial: raw
-            .initial
-            .into_iter()
-            .map(|i| InitialOverride {
-                coordinate: i.coord,
-                value: i.value,
-                velocity: i.velocity,
-            })
-            .collect(),
-        end_time: raw.end_time,
-        integrator,
-        output: OutputSpec {
-            interval: raw.output.interval,
-            coordinates: raw.output.coordinates,
-            velocities: raw.output.velocities,
-            bodies: raw.output.bodies,
-            forces: raw.output.forces,
-        },
-        output_file: raw.output_file.map(|f| dir.join(f)),
-        track,
-    })
+    parameters
 }
 
 impl Scenario {
@@ -469,6 +517,527 @@ impl Scenario {
             Ok((q, v))
         } else {
             Err(ModelErrors(errors))
+        }
+    }
+}
+
+/// A coupler between bodies of two vehicles of a train: a linear spring–damper
+/// between a point of each body, in the frame of body 1 (like a `Linear6`
+/// element): the force on body 2 is −(K δ + C δ̇ + F₀) with δ the position of
+/// point 2 relative to point 1 in body 1's axes and the small relative
+/// rotation (angular stiffness and damping, default 0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainCoupler {
+    pub name: String,
+    /// Vehicle index (in `TrainScenario::vehicles`) and body long name within
+    /// its model, from `"Coach1.body"`.
+    pub vehicle1: usize,
+    pub body1: String,
+    /// Attachment point in body 1's frame (from its centre of mass), m.
+    pub point1: [f64; 3],
+    pub vehicle2: usize,
+    pub body2: String,
+    pub point2: [f64; 3],
+    /// Translational stiffness along x, y, z of body 1, N/m.
+    pub stiffness: [f64; 3],
+    /// Translational damping, N s/m.
+    pub damping: [f64; 3],
+    /// Rotational stiffness about x, y, z, N m/rad.
+    pub angular_stiffness: [f64; 3],
+    /// Rotational damping, N m s/rad.
+    pub angular_damping: [f64; 3],
+    /// Constant force F₀, N (positive x: body 2 pushed backwards, i.e. a
+    /// compressed coupler between a leading body 1 and a trailing body 2).
+    pub preload: [f64; 3],
+}
+
+/// One vehicle of a train: a model file at an arc offset from the train's
+/// reference point, with its own macros, parameter overrides and initial
+/// conditions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainVehicle {
+    /// Instance name, prefix of all its output columns (`Coach2.body.x[m]`).
+    pub name: String,
+    /// Model file, resolved relative to the train file.
+    pub model: PathBuf,
+    /// Arc offset of the vehicle's reference point from the train's, m
+    /// (negative behind: 0, −26, −52 for three 26 m coaches).
+    pub offset: f64,
+    pub macros: Vec<String>,
+    /// The train's `parameters` known to this model, then the vehicle's own.
+    pub parameters: Vec<(String, String)>,
+    pub initial: Vec<InitialOverride>,
+}
+
+/// A resolved train scenario (a `Train(...)` file): several vehicles, each
+/// from its own model, on one track at one running speed, coupled by couplers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainScenario {
+    /// The train file.
+    pub source: PathBuf,
+    pub vehicles: Vec<TrainVehicle>,
+    pub couplers: Vec<TrainCoupler>,
+    /// Train-wide parameter overrides (applied to every vehicle whose model
+    /// has the parameter; each must be known to at least one model).
+    pub parameters: Vec<(String, String)>,
+    pub end_time: f64,
+    pub integrator: IntegratorSpec,
+    /// Names in `bodies` and `forces` are `<vehicle>.<long name>` or `"*"`;
+    /// coordinates are written as `<vehicle>.<coordinate>`. Coupler forces
+    /// are always written.
+    pub output: OutputSpec,
+    pub output_file: Option<PathBuf>,
+    /// The train's reference point starts at `start` (the first vehicle at
+    /// offset 0 usually) and runs at `speed`.
+    pub track: ScenarioTrack,
+}
+
+/// A scenario file of either kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyScenario {
+    /// `Scenario(...)`: one model.
+    Single(Scenario),
+    /// `Train(...)`: several vehicles coupled.
+    Train(TrainScenario),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Train", deny_unknown_fields)]
+struct RawTrain {
+    vehicles: Vec<RawVehicle>,
+    #[serde(default)]
+    couplers: Vec<RawCoupler>,
+    #[serde(default)]
+    parameters: OrderedMap<Value>,
+    end_time: f64,
+    integrator: RawIntegrator,
+    output: RawOutput,
+    #[serde(default, deserialize_with = "some")]
+    output_file: Option<String>,
+    track: RawTrack,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Vehicle", deny_unknown_fields)]
+struct RawVehicle {
+    name: String,
+    model: String,
+    #[serde(default)]
+    offset: f64,
+    #[serde(default)]
+    macros: Vec<String>,
+    #[serde(default)]
+    parameters: OrderedMap<Value>,
+    #[serde(default)]
+    initial: Vec<RawInitial>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Coupler", deny_unknown_fields)]
+struct RawCoupler {
+    name: String,
+    body1: String,
+    #[serde(default)]
+    point1: (f64, f64, f64),
+    body2: String,
+    #[serde(default)]
+    point2: (f64, f64, f64),
+    stiffness: (f64, f64, f64),
+    #[serde(default)]
+    damping: (f64, f64, f64),
+    #[serde(default)]
+    angular_stiffness: (f64, f64, f64),
+    #[serde(default)]
+    angular_damping: (f64, f64, f64),
+    #[serde(default)]
+    preload: (f64, f64, f64),
+}
+
+/// The constructor name of the file's top-level value (`Scenario`, `Train`),
+/// after whitespace and comments.
+fn top_constructor(text: &str) -> Option<&str> {
+    let mut rest = text;
+    loop {
+        rest = rest.trim_start();
+        if let Some(r) = rest.strip_prefix("//") {
+            rest = r.split_once('\n').map_or("", |x| x.1);
+        } else if let Some(r) = rest.strip_prefix("/*") {
+            rest = r.split_once("*/").map_or("", |x| x.1);
+        } else {
+            break;
+        }
+    }
+    let end = rest
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .unwrap_or(rest.len());
+    (end > 0).then(|| &rest[..end])
+}
+
+/// Reads a scenario file of either kind: `Train(...)` files are trains,
+/// anything else goes to [`load_scenario`].
+pub fn load_any_scenario(path: &Path) -> Result<AnyScenario, ModelErrors> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", format!("cannot read the scenario file: {e}")))?;
+    if top_constructor(&text) == Some("Train") {
+        parse_train(&text, path).map(AnyScenario::Train)
+    } else {
+        parse_scenario(&text, path).map(AnyScenario::Single)
+    }
+}
+
+/// Reads a train file (`Train(...)`).
+pub fn load_train(path: &Path) -> Result<TrainScenario, ModelErrors> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", format!("cannot read the train file: {e}")))?;
+    parse_train(&text, path)
+}
+
+/// Resolves train text; `path` is the train file (for errors and relative
+/// paths). Vehicle and coupler names are checked here; body names of
+/// couplers against the models by [`TrainScenario::resolve_couplers`].
+pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors> {
+    let loc = Locator::new(text);
+    let raw: RawTrain = ron::Options::default()
+        .from_str(text)
+        .map_err(|e| ron_error(&loc, path, e))?;
+    let mut errors = Vec::new();
+    // Errors at a key (first occurrence) or, for an element, at its name.
+    let mut report = |key: &str, literal: Option<&str>, element: String, message: String| {
+        let position = loc.top().and_then(|top| {
+            literal
+                .and_then(|l| loc.string_in(top, l))
+                .or_else(|| loc.key_anywhere(top, key))
+                .map(|k| loc.pos(k))
+        });
+        errors.push(ModelError {
+            file: path.to_path_buf(),
+            element,
+            message,
+            position,
+        });
+    };
+    let mut check = |ok: bool, key: &str, message: String| {
+        if !ok {
+            report(key, None, String::new(), message);
+        }
+    };
+    let Common {
+        integrator,
+        output,
+        track,
+        parameters,
+    } = common(
+        raw.end_time,
+        raw.integrator,
+        raw.output,
+        Some(raw.track),
+        raw.parameters,
+        path,
+        &mut check,
+    );
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut vehicles: Vec<TrainVehicle> = Vec::new();
+    let mut problems: Vec<(String, Option<String>, String, String)> = Vec::new();
+    for v in raw.vehicles {
+        let element = format!("vehicle \"{}\"", v.name);
+        if v.name.is_empty() || v.name.contains('.') || v.name == "*" {
+            problems.push((
+                "name".into(),
+                Some(v.name.clone()),
+                element.clone(),
+                "a vehicle name must be non-empty, without '.', and not \"*\"".into(),
+            ));
+        }
+        if vehicles.iter().any(|w| w.name == v.name) {
+            problems.push((
+                "name".into(),
+                Some(v.name.clone()),
+                element.clone(),
+                "two vehicles have this name".into(),
+            ));
+        }
+        if !v.offset.is_finite() {
+            problems.push((
+                "offset".into(),
+                Some(v.name.clone()),
+                element.clone(),
+                format!("offset must be finite, got {} m", v.offset),
+            ));
+        }
+        for init in &v.initial {
+            let finite = [init.value, init.velocity]
+                .iter()
+                .all(|x| x.is_none_or(f64::is_finite));
+            if !finite || (init.value.is_none() && init.velocity.is_none()) {
+                problems.push((
+                    "initial".into(),
+                    Some(init.coord.clone()),
+                    element.clone(),
+                    format!(
+                        "initial condition of \"{}\" must set a finite value or velocity",
+                        init.coord
+                    ),
+                ));
+            }
+        }
+        let mut own_check = |ok: bool, key: &str, message: String| {
+            if !ok {
+                problems.push((key.into(), None, element.clone(), message));
+            }
+        };
+        let own = overrides(v.parameters, &mut own_check);
+        vehicles.push(TrainVehicle {
+            name: v.name,
+            model: dir.join(v.model),
+            offset: v.offset,
+            macros: v.macros,
+            parameters: own,
+            initial: v
+                .initial
+                .into_iter()
+                .map(|i| InitialOverride {
+                    coordinate: i.coord,
+                    value: i.value,
+                    velocity: i.velocity,
+                })
+                .collect(),
+        });
+    }
+    if vehicles.is_empty() {
+        problems.push((
+            "vehicles".into(),
+            None,
+            String::new(),
+            "a train needs at least one vehicle".into(),
+        ));
+    }
+    let mut couplers: Vec<TrainCoupler> = Vec::new();
+    for c in raw.couplers {
+        let element = format!("coupler \"{}\"", c.name);
+        if couplers.iter().any(|d| d.name == c.name) || c.name.is_empty() {
+            problems.push((
+                "name".into(),
+                Some(c.name.clone()),
+                element.clone(),
+                "coupler names must be non-empty and unique".into(),
+            ));
+        }
+        let mut side = |body: &str| -> Option<(usize, String)> {
+            let found = body.split_once('.').and_then(|(v, b)| {
+                vehicles
+                    .iter()
+                    .position(|w| w.name == v)
+                    .map(|k| (k, b.to_string()))
+            });
+            if found.is_none() {
+                let known: Vec<&str> = vehicles.iter().map(|w| w.name.as_str()).collect();
+                problems.push((
+                    "body1".into(),
+                    Some(body.to_string()),
+                    element.clone(),
+                    format!(
+                        "body \"{body}\" must be \"<vehicle>.<body>\" with a vehicle of the \
+                         train (vehicles: {})",
+                        known.join(", ")
+                    ),
+                ));
+            }
+            found
+        };
+        let s1 = side(&c.body1);
+        let s2 = side(&c.body2);
+        let v3 = |t: (f64, f64, f64)| [t.0, t.1, t.2];
+        let numbers = [
+            c.point1,
+            c.point2,
+            c.stiffness,
+            c.damping,
+            c.angular_stiffness,
+            c.angular_damping,
+            c.preload,
+        ];
+        if numbers
+            .iter()
+            .any(|t| !(t.0.is_finite() && t.1.is_finite() && t.2.is_finite()))
+        {
+            problems.push((
+                "stiffness".into(),
+                Some(c.name.clone()),
+                element.clone(),
+                "points, stiffness, damping and preload must be finite".into(),
+            ));
+        }
+        if let (Some((k1, b1)), Some((k2, b2))) = (s1, s2) {
+            if k1 == k2 {
+                problems.push((
+                    "body2".into(),
+                    Some(c.body2.clone()),
+                    element.clone(),
+                    "a coupler joins two different vehicles (use a force element of the \
+                     model within one vehicle)"
+                        .into(),
+                ));
+            }
+            couplers.push(TrainCoupler {
+                name: c.name,
+                vehicle1: k1,
+                body1: b1,
+                point1: v3(c.point1),
+                vehicle2: k2,
+                body2: b2,
+                point2: v3(c.point2),
+                stiffness: v3(c.stiffness),
+                damping: v3(c.damping),
+                angular_stiffness: v3(c.angular_stiffness),
+                angular_damping: v3(c.angular_damping),
+                preload: v3(c.preload),
+            });
+        }
+    }
+    for (key, literal, element, message) in problems {
+        report(&key, literal.as_deref(), element, message);
+    }
+    if !errors.is_empty() {
+        errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
+        return Err(ModelErrors(errors));
+    }
+    Ok(TrainScenario {
+        source: path.to_path_buf(),
+        vehicles,
+        couplers,
+        parameters,
+        end_time: raw.end_time,
+        integrator,
+        output,
+        output_file: raw.output_file.map(|f| dir.join(f)),
+        track: track.expect("a train always has a track"),
+    })
+}
+
+impl TrainScenario {
+    /// Locates a string literal in the train file, if it can still be read.
+    fn locate(&self, literal: &str) -> Option<(usize, usize)> {
+        let text = std::fs::read_to_string(&self.source).ok()?;
+        let loc = Locator::new(&text);
+        let top = loc.top()?;
+        loc.string_in(top, literal).map(|k| loc.pos(k))
+    }
+
+    /// The single-model scenario of vehicle `k` with its `model`: the train's
+    /// integrator and end time, the train-wide parameters its model knows then
+    /// its own, the track with the start shifted by the vehicle's offset, and
+    /// the output names selecting its bodies and elements (without the
+    /// vehicle prefix). [`TrainScenario::check_names`] reports train-wide
+    /// parameters and output names no vehicle knows.
+    pub fn vehicle_scenario(&self, k: usize, model: &Model) -> Scenario {
+        let v = &self.vehicles[k];
+        let mut parameters: Vec<(String, String)> = self
+            .parameters
+            .iter()
+            .filter(|(n, _)| model.parameter_index(n).is_some())
+            .cloned()
+            .collect();
+        parameters.extend(v.parameters.iter().cloned());
+        let prefix = format!("{}.", v.name);
+        let mine = |names: &[String]| -> Vec<String> {
+            if names.iter().any(|n| n == "*") {
+                return vec!["*".to_string()];
+            }
+            names
+                .iter()
+                .filter_map(|n| n.strip_prefix(&prefix).map(str::to_string))
+                .collect()
+        };
+        let mut track = self.track.clone();
+        track.start += v.offset;
+        Scenario {
+            source: self.source.clone(),
+            model: v.model.clone(),
+            macros: v.macros.clone(),
+            parameters,
+            initial: v.initial.clone(),
+            end_time: self.end_time,
+            integrator: self.integrator.clone(),
+            output: OutputSpec {
+                interval: self.output.interval,
+                coordinates: self.output.coordinates,
+                velocities: self.output.velocities,
+                bodies: mine(&self.output.bodies),
+                forces: mine(&self.output.forces),
+            },
+            output_file: None,
+            track: Some(track),
+        }
+    }
+
+    /// Checks that every train-wide parameter is known to some vehicle's
+    /// model and every output name starts with a vehicle name (`models` in
+    /// vehicle order).
+    pub fn check_names(&self, models: &[&Model]) -> Result<(), ModelErrors> {
+        let mut errors = Vec::new();
+        for (name, _) in &self.parameters {
+            if !models.iter().any(|m| m.parameter_index(name).is_some()) {
+                errors.push(ModelError {
+                    file: self.source.clone(),
+                    element: format!("parameter \"{name}\""),
+                    message: "no vehicle's model has this parameter".into(),
+                    position: self.locate(name),
+                });
+            }
+        }
+        for name in self.output.bodies.iter().chain(&self.output.forces) {
+            if name == "*" {
+                continue;
+            }
+            let known = self
+                .vehicles
+                .iter()
+                .any(|v| name.strip_prefix(&format!("{}.", v.name)).is_some());
+            if !known {
+                errors.push(ModelError {
+                    file: self.source.clone(),
+                    element: format!("output \"{name}\""),
+                    message: "output names are \"<vehicle>.<long name>\" (or \"*\")".into(),
+                    position: self.locate(name),
+                });
+            }
+        }
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            Err(ModelErrors(errors))
+        }
+    }
+
+    /// Body indices of coupler `c`'s two bodies in their vehicles' models
+    /// (`models` in vehicle order); unknown bodies are errors at their name.
+    pub fn resolve_coupler(
+        &self,
+        c: &TrainCoupler,
+        models: &[&Model],
+    ) -> Result<(usize, usize), ModelErrors> {
+        let mut errors = Vec::new();
+        let mut find = |k: usize, body: &str| {
+            let found = models[k].body_index(body);
+            if found.is_none() {
+                let full = format!("{}.{body}", self.vehicles[k].name);
+                errors.push(ModelError {
+                    file: self.source.clone(),
+                    element: format!("coupler \"{}\"", c.name),
+                    message: format!(
+                        "model \"{}\" of vehicle \"{}\" has no body \"{body}\"",
+                        models[k].name, self.vehicles[k].name
+                    ),
+                    position: self.locate(&full),
+                });
+            }
+            found
+        };
+        let b1 = find(c.vehicle1, &c.body1);
+        let b2 = find(c.vehicle2, &c.body2);
+        match (b1, b2) {
+            (Some(b1), Some(b2)) => Ok((b1, b2)),
+            _ => Err(ModelErrors(errors)),
         }
     }
 }

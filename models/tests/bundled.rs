@@ -37,10 +37,28 @@ fn bundled_models_load() {
 fn bundled_scenarios_resolve() {
     let mut problems = Vec::new();
     for path in ron_files("scenarios") {
-        let resolved = load_scenario(&path).and_then(|sc| {
-            let model = load_model(&sc.model)?;
-            let p = sc.parameter_values(&model)?;
-            sc.initial_state(&model, &p).map(|_| ())
+        let resolve = |sc: &Scenario, model: &Model| {
+            let p = sc.parameter_values(model)?;
+            sc.initial_state(model, &p).map(|_| ())
+        };
+        let resolved = load_any_scenario(&path).and_then(|any| match any {
+            AnyScenario::Single(sc) => resolve(&sc, &load_model(&sc.model)?),
+            AnyScenario::Train(train) => {
+                let models = train
+                    .vehicles
+                    .iter()
+                    .map(|v| load_model(&v.model))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let refs: Vec<&Model> = models.iter().collect();
+                train.check_names(&refs)?;
+                for c in &train.couplers {
+                    train.resolve_coupler(c, &refs)?;
+                }
+                for (k, model) in models.iter().enumerate() {
+                    resolve(&train.vehicle_scenario(k, model), model)?;
+                }
+                Ok(())
+            }
         });
         if let Err(e) = resolved {
             problems.push(e.to_string());

@@ -15,6 +15,7 @@ pub mod plugin;
 pub mod simulate;
 pub mod system;
 pub mod track_inputs;
+pub mod train;
 
 pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
 pub use inputs::{DrivenEquations, InputProvider};

@@ -118,6 +118,19 @@ impl ModelSystem {
         self.forces.iter().flat_map(|f| f.assessment()).collect()
     }
 
+    /// The buffers of the last evaluation (by `dynamics`, `force_jacobian` or
+    /// `evaluate`), e.g. for forces applied from outside the model.
+    pub fn last_evaluation(&self) -> &Evaluation {
+        &self.eval
+    }
+
+    /// Makes `dynamics` always evaluate body kinematics and Jacobians (for
+    /// forces applied from outside the model: a train's couplers).
+    pub fn require_body_jacobians(&mut self) {
+        self.dynamics_parts.kinematics = true;
+        self.dynamics_parts.jacobians = true;
+    }
+
     /// The engine.
     pub fn equations(&self) -> &dyn Equations {
         self.equations.as_ref()

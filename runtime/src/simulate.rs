@@ -57,7 +57,7 @@ pub struct RunSummary {
 
 impl RunSummary {
     /// Adds the counts of one integration segment and records its end time.
-    fn add_segment(&mut self, st: &IntegrationStats) {
+    pub(crate) fn add_segment(&mut self, st: &IntegrationStats) {
         self.steps += st.steps;
         self.rejected_steps += st.rejected_steps;
         self.newton_iterations += st.newton_iterations;
@@ -106,8 +106,8 @@ pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState
 }
 
 /// Column layout of the output file.
-struct Columns {
-    header: Vec<String>,
+pub(crate) struct Columns {
+    pub(crate) header: Vec<String>,
     /// The running speed law, when the run is on a track: the column `s[m]`
     /// (arc position of the vehicle's reference point) follows `time`.
     arc: Option<RunningSpeed>,
@@ -142,7 +142,7 @@ fn select(
         .collect()
 }
 
-fn columns(
+pub(crate) fn columns(
     model: &Model,
     system: &ModelSystem,
     spec: &OutputSpec,
@@ -206,6 +206,45 @@ fn columns(
     })
 }
 
+impl Columns {
+    /// Appends the values of the columns after `time` and `s[m]` at a state
+    /// (`force_values` is scratch for all force elements' outputs).
+    pub(crate) fn values(
+        &self,
+        system: &mut ModelSystem,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        values: &mut Vec<f64>,
+        force_values: &mut Vec<f64>,
+    ) -> Result<(), RunError> {
+        if self.coordinates {
+            values.extend_from_slice(q);
+        }
+        if self.velocities {
+            values.extend_from_slice(v);
+        }
+        if self.need_kinematics {
+            let eval = system.evaluate(t, q, v, Parts::KINEMATICS)?;
+            for &b in &self.bodies {
+                let k = &eval.bodies[b];
+                values.extend(k.position.iter());
+                values.extend(xyz_angles(&k.rotation).iter());
+                values.extend(k.velocity.iter());
+                values.extend(k.angular_velocity.iter());
+            }
+            let mut all = std::mem::take(force_values);
+            all.clear();
+            system.force_outputs(t, &mut all);
+            for &(offset, count) in &self.forces {
+                values.extend_from_slice(&all[offset..offset + count]);
+            }
+            *force_values = all;
+        }
+        Ok(())
+    }
+}
+
 /// Cardan angles of a rotation matrix for the sequence x, y, z of the moving
 /// frame (A = Rx(a) Ry(b) Rz(c)), rad.
 pub fn xyz_angles(a: &Matrix3<f64>) -> Vector3<f64> {
@@ -218,11 +257,11 @@ pub fn xyz_angles(a: &Matrix3<f64>) -> Vector3<f64> {
 /// An engine driven along the track: the wrapped equations, the times at
 /// which the frames pass kinks of the track, and the track for the force
 /// elements that need it.
-type DrivenModel = (Box<dyn Equations>, Vec<f64>, Option<TrackBinding>);
+pub(crate) type DrivenModel = (Box<dyn Equations>, Vec<f64>, Option<TrackBinding>);
 
 /// Wraps the engine of a model with track-following frames so that the
 /// scenario's track drives them; other models pass through.
-fn drive_track_frames(
+pub(crate) fn drive_track_frames(
     scenario: &Scenario,
     model: &Model,
     params: &[f64],
@@ -304,7 +343,7 @@ fn body_velocities(e: &crate::equations::Evaluation) -> nalgebra::DVector<f64> {
 /// this much before a kink of the track and restart this much after it, so
 /// that no step ever ends exactly on the kink (where the inputs are one-sided).
 /// At 100 m/s it moves a frame by 1e-8 m per second of simulated time.
-fn breakpoint_gap(t: f64) -> f64 {
+pub(crate) fn breakpoint_gap(t: f64) -> f64 {
     1e-10 * t.abs().max(1.0)
 }
 
@@ -313,7 +352,7 @@ fn breakpoint_gap(t: f64) -> f64 {
 /// bodies' absolute velocities do not. Solves Γ(t⁺) q̇⁺ + γ(t⁺) = V(t⁻) for all
 /// bodies in the least-squares sense (exact for bodies with six coordinates
 /// relative to their frame), γ being the rheonomic part of the body velocities.
-fn continuous_velocities(
+pub(crate) fn continuous_velocities(
     system: &mut ModelSystem,
     t_before: f64,
     t_after: f64,
@@ -339,10 +378,10 @@ fn continuous_velocities(
 }
 
 /// Time, coordinates, velocities and accelerations at the end of a step.
-type StepEnd = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+pub(crate) type StepEnd = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Cubic Hermite interpolation on [t0, t1] from values and derivatives.
-fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f64) -> f64 {
+pub(crate) fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f64) -> f64 {
     let h = t1 - t0;
     if h <= 0.0 {
         return y1;
@@ -357,8 +396,8 @@ fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f64) -> f64 
 }
 
 /// Integrator settings of a scenario.
-fn run_integrator(
-    system: &mut ModelSystem,
+pub(crate) fn run_integrator<S: crate::system::MechanicalSystem>(
+    system: &mut S,
     spec: &IntegratorSpec,
     t0: f64,
     q0: &[f64],
@@ -441,29 +480,7 @@ impl Recorder {
                 .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))?;
             self.values.push(s.s);
         }
-        if cols.coordinates {
-            self.values.extend_from_slice(q);
-        }
-        if cols.velocities {
-            self.values.extend_from_slice(v);
-        }
-        if cols.need_kinematics {
-            let eval = system.evaluate(t, q, v, Parts::KINEMATICS)?;
-            for &b in &cols.bodies {
-                let k = &eval.bodies[b];
-                self.values.extend(k.position.iter());
-                self.values.extend(xyz_angles(&k.rotation).iter());
-                self.values.extend(k.velocity.iter());
-                self.values.extend(k.angular_velocity.iter());
-            }
-            let mut all = std::mem::take(&mut self.force_values);
-            all.clear();
-            system.force_outputs(t, &mut all);
-            for &(offset, count) in &cols.forces {
-                self.values.extend_from_slice(&all[offset..offset + count]);
-            }
-            self.force_values = all;
-        }
+        cols.values(system, t, q, v, &mut self.values, &mut self.force_values)?;
         if let Some((path, w)) = self.writer.as_mut() {
             use std::fmt::Write as _;
             self.line.clear();

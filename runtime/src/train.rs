@@ -1,0 +1,821 @@
+//! Trains: several vehicles, each a model with its own engine (numeric, or
+//! the compiled plugin of its model file), running on one track at arc
+//! offsets from the train's reference point, coupled by coupler force
+//! elements between bodies of different vehicles (external subsystems, seed
+//! paper Sect. 5).
+//!
+//! The assembled system ([`TrainSystem`]) stacks the vehicles' coordinates in
+//! vehicle order: its mass matrix is block-diagonal (one block per vehicle),
+//! its generalized forces are the vehicles' own plus the couplers' wrenches
+//! projected by the body Jacobians Γ of each side. For Park's Newton
+//! iteration the couplers' local stiffness and damping are mapped by the same
+//! Jacobians into the diagonal blocks and the off-diagonal (vehicle–vehicle)
+//! blocks of ∂f/∂q and ∂f/∂q̇.
+//!
+//! Each vehicle's track-following frames follow the train's speed law shifted
+//! by the vehicle's offset ([`TrainScenario::vehicle_scenario`]), so a vehicle
+//! of the train sees exactly the track a single-vehicle scenario starting at
+//! `start + offset` would, and a train of one vehicle without couplers runs
+//! the same trajectory as the plain scenario.
+
+use crate::equations::{BodyKinematics, Equations, Parts};
+use crate::forces::{
+    Assessment, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
+};
+use crate::model_system::ModelSystem;
+use crate::simulate::{
+    Columns, RunError, RunSummary, StepEnd, breakpoint_gap, columns, continuous_velocities,
+    drive_track_frames, hermite, run_integrator, scenario_state,
+};
+use crate::system::{MechanicalSystem, SimError};
+use crate::track_inputs::RunningSpeed;
+use nalgebra::{DMatrix, DVector};
+use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model, TrainCoupler, TrainScenario};
+use std::cell::RefCell;
+use std::io::Write;
+use std::ops::{ControlFlow, Range};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::time::Instant;
+
+/// A coupler between body `bodies[0]` of vehicle `vehicles[0]` and body
+/// `bodies[1]` of vehicle `vehicles[1]`: a [`Linear6`] element whose two
+/// bodies are those, seen as bodies 0 and 1 of a two-body context.
+#[derive(Debug, Clone)]
+pub struct Coupler {
+    name: String,
+    vehicles: [usize; 2],
+    bodies: [usize; 2],
+    element: Linear6,
+}
+
+impl Coupler {
+    /// The coupler `spec` between body `body1` of its vehicle 1 and `body2` of
+    /// its vehicle 2 (body indices in the vehicles' models).
+    pub fn new(spec: &TrainCoupler, body1: usize, body2: usize) -> Result<Self, SimError> {
+        let num3 = |p: [f64; 3]| p.map(Expr::num);
+        let frame = |p: [f64; 3]| Frame {
+            origin: num3(p),
+            rotation_xyz: num3([0.0; 3]),
+        };
+        let diag = |lin: [f64; 3], ang: [f64; 3]| {
+            let mut m: [Expr; 36] = std::array::from_fn(|_| Expr::num(0.0));
+            for k in 0..3 {
+                m[7 * k] = Expr::num(lin[k]);
+                m[7 * (k + 3)] = Expr::num(ang[k]);
+            }
+            Box::new(m)
+        };
+        let p = spec.preload;
+        let kind = ForceKind::Linear6 {
+            body1: BodyRef::Body(0),
+            frame1: frame(spec.point1),
+            body2: BodyRef::Body(1),
+            frame2: frame(spec.point2),
+            stiffness: diag(spec.stiffness, spec.angular_stiffness),
+            damping: diag(spec.damping, spec.angular_damping),
+            preload: [p[0], p[1], p[2], 0.0, 0.0, 0.0].map(Expr::num),
+        };
+        let mut element = Linear6::new(spec.name.clone(), &kind);
+        element.set_parameters(&[])?;
+        Ok(Self {
+            name: spec.name.clone(),
+            vehicles: [spec.vehicle1, spec.vehicle2],
+            bodies: [body1, body2],
+            element,
+        })
+    }
+
+    /// Long name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Output names (without the coupler's name): the force and moment body
+    /// 1 exerts on body 2, in body 1's axes.
+    pub fn output_names(&self) -> Vec<String> {
+        self.element.output_names()
+    }
+}
+
+/// Several vehicles coupled: a [`MechanicalSystem`] with the vehicles'
+/// coordinates stacked in vehicle order.
+pub struct TrainSystem {
+    names: Vec<String>,
+    vehicles: Vec<ModelSystem>,
+    /// Coordinate range of each vehicle in the train's q.
+    ranges: Vec<Range<usize>>,
+    /// Constraint range of each vehicle.
+    constraint_ranges: Vec<Range<usize>>,
+    couplers: Vec<Coupler>,
+    mass: Vec<DMatrix<f64>>,
+    force: Vec<DVector<f64>>,
+    dq: Vec<DMatrix<f64>>,
+    dv: Vec<DMatrix<f64>>,
+    g: Vec<DVector<f64>>,
+    gq: Vec<DMatrix<f64>>,
+    scratch: JacobianScratch,
+    recorder: Option<Rc<RefCell<TrainRecorder>>>,
+}
+
+impl std::fmt::Debug for TrainSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TrainSystem")
+            .field("vehicles", &self.names)
+            .field("dof", &self.dof())
+            .field("couplers", &self.couplers.len())
+            .finish()
+    }
+}
+
+impl TrainSystem {
+    /// Vehicles (name, system) in train order and the couplers between them.
+    pub fn new(
+        vehicles: Vec<(String, ModelSystem)>,
+        couplers: Vec<Coupler>,
+    ) -> Result<Self, SimError> {
+        let (names, mut systems): (Vec<String>, Vec<ModelSystem>) = vehicles.into_iter().unzip();
+        for c in &couplers {
+            for (&k, &b) in c.vehicles.iter().zip(&c.bodies) {
+                let Some(s) = systems.get_mut(k) else {
+                    return Err(SimError::Other(format!(
+                        "coupler \"{}\": no vehicle {k} in a train of {}",
+                        c.name,
+                        names.len()
+                    )));
+                };
+                if b >= s.equations().body_count() {
+                    return Err(SimError::Other(format!(
+                        "coupler \"{}\": vehicle \"{}\" has no body {b}",
+                        c.name, names[k]
+                    )));
+                }
+                s.require_body_jacobians();
+            }
+        }
+        let mut ranges = Vec::new();
+        let mut constraint_ranges = Vec::new();
+        let (mut n, mut nc) = (0, 0);
+        for s in &systems {
+            ranges.push(n..n + s.dof());
+            constraint_ranges.push(nc..nc + s.n_constraints());
+            n += s.dof();
+            nc += s.n_constraints();
+        }
+        let square = |s: &ModelSystem| DMatrix::zeros(s.dof(), s.dof());
+        Ok(Self {
+            mass: systems.iter().map(square).collect(),
+            force: systems.iter().map(|s| DVector::zeros(s.dof())).collect(),
+            dq: systems.iter().map(square).collect(),
+            dv: systems.iter().map(square).collect(),
+            g: systems
+                .iter()
+                .map(|s| DVector::zeros(s.n_constraints()))
+                .collect(),
+            gq: systems
+                .iter()
+                .map(|s| DMatrix::zeros(s.n_constraints(), s.dof()))
+                .collect(),
+            scratch: JacobianScratch::new(n),
+            names,
+            vehicles: systems,
+            ranges,
+            constraint_ranges,
+            couplers,
+            recorder: None,
+        })
+    }
+
+    /// Number of vehicles.
+    pub fn vehicle_count(&self) -> usize {
+        self.vehicles.len()
+    }
+
+    /// Vehicle `k`'s name.
+    pub fn vehicle_name(&self, k: usize) -> &str {
+        &self.names[k]
+    }
+
+    /// Vehicle `k`'s system.
+    pub fn vehicle(&self, k: usize) -> &ModelSystem {
+        &self.vehicles[k]
+    }
+
+    /// Vehicle `k`'s system, mutable (to evaluate it at a state).
+    pub fn vehicle_mut(&mut self, k: usize) -> &mut ModelSystem {
+        &mut self.vehicles[k]
+    }
+
+    /// Vehicle `k`'s coordinates in the train's q.
+    pub fn range(&self, k: usize) -> Range<usize> {
+        self.ranges[k].clone()
+    }
+
+    /// The couplers.
+    pub fn couplers(&self) -> &[Coupler] {
+        &self.couplers
+    }
+
+    /// Assessment maxima of every vehicle, element names prefixed by the
+    /// vehicle's name.
+    pub fn assessment(&self) -> Vec<Assessment> {
+        self.vehicles
+            .iter()
+            .zip(&self.names)
+            .flat_map(|(s, name)| {
+                s.assessment().into_iter().map(move |mut a| {
+                    a.element = format!("{name}.{}", a.element);
+                    a
+                })
+            })
+            .collect()
+    }
+
+    /// Kinematics of both bodies of coupler `c` from the vehicles' last
+    /// evaluations.
+    fn coupler_bodies(&self, c: &Coupler) -> [BodyKinematics; 2] {
+        [0, 1].map(|i| self.vehicles[c.vehicles[i]].last_evaluation().bodies[c.bodies[i]])
+    }
+
+    /// Coupler outputs at a state (evaluates the coupled vehicles'
+    /// kinematics), appended to `out` in coupler order.
+    pub fn coupler_outputs(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        out: &mut Vec<f64>,
+    ) -> Result<(), SimError> {
+        for ci in 0..self.couplers.len() {
+            let mut bodies = [BodyKinematics::default(); 2];
+            for (i, body) in bodies.iter_mut().enumerate() {
+                let (k, b) = (self.couplers[ci].vehicles[i], self.couplers[ci].bodies[i]);
+                let r = self.ranges[k].clone();
+                let e = self.vehicles[k].evaluate(t, &q[r.clone()], &v[r], Parts::KINEMATICS)?;
+                *body = e.bodies[b];
+            }
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+            };
+            self.couplers[ci].element.outputs(&ctx, out);
+        }
+        Ok(())
+    }
+}
+
+impl MechanicalSystem for TrainSystem {
+    fn dof(&self) -> usize {
+        self.ranges.last().map_or(0, |r| r.end)
+    }
+
+    fn n_constraints(&self) -> usize {
+        self.constraint_ranges.last().map_or(0, |r| r.end)
+    }
+
+    fn dynamics(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        mass.fill(0.0);
+        for (k, s) in self.vehicles.iter_mut().enumerate() {
+            let r = self.ranges[k].clone();
+            s.dynamics(
+                t,
+                &q[r.clone()],
+                &v[r.clone()],
+                &mut self.mass[k],
+                &mut self.force[k],
+            )?;
+            mass.view_mut((r.start, r.start), (r.len(), r.len()))
+                .copy_from(&self.mass[k]);
+            force.rows_mut(r.start, r.len()).copy_from(&self.force[k]);
+        }
+        for c in &self.couplers {
+            let bodies = self.coupler_bodies(c);
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+            };
+            let mut w = [Wrench::default(); 2];
+            c.element.apply(&ctx, &mut w)?;
+            for ((&k, &b), w) in c.vehicles.iter().zip(&c.bodies).zip(&w) {
+                let comps = [
+                    w.force.x, w.force.y, w.force.z, w.moment.x, w.moment.y, w.moment.z,
+                ];
+                let gamma = &self.vehicles[k].last_evaluation().jacobians;
+                let r = self.ranges[k].clone();
+                for (col, qi) in r.enumerate() {
+                    let mut s = 0.0;
+                    for (row, x) in comps.iter().enumerate() {
+                        s += gamma[(6 * b + row, col)] * x;
+                    }
+                    force[qi] += s;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn constraints(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        g: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), SimError> {
+        jacobian.fill(0.0);
+        for (k, s) in self.vehicles.iter_mut().enumerate() {
+            let (r, c) = (self.ranges[k].clone(), self.constraint_ranges[k].clone());
+            if c.is_empty() {
+                continue;
+            }
+            s.constraints(t, &q[r.clone()], &mut self.g[k], &mut self.gq[k])?;
+            g.rows_mut(c.start, c.len()).copy_from(&self.g[k]);
+            jacobian
+                .view_mut((c.start, r.start), (c.len(), r.len()))
+                .copy_from(&self.gq[k]);
+        }
+        Ok(())
+    }
+
+    /// The vehicles' approximate Jacobians in the diagonal blocks plus the
+    /// couplers' (local stiffness and damping mapped by the Jacobians of both
+    /// attachment points, which fills the blocks between coupled vehicles).
+    /// If a vehicle has none (no force elements), the integrator
+    /// differentiates the whole train numerically.
+    fn force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut DMatrix<f64>,
+        dfdv: &mut DMatrix<f64>,
+    ) -> Result<bool, SimError> {
+        dfdq.fill(0.0);
+        dfdv.fill(0.0);
+        for (k, s) in self.vehicles.iter_mut().enumerate() {
+            let r = self.ranges[k].clone();
+            if !s.force_jacobian(
+                t,
+                &q[r.clone()],
+                &v[r.clone()],
+                &mut self.dq[k],
+                &mut self.dv[k],
+            )? {
+                return Ok(false);
+            }
+            dfdq.view_mut((r.start, r.start), (r.len(), r.len()))
+                .copy_from(&self.dq[k]);
+            dfdv.view_mut((r.start, r.start), (r.len(), r.len()))
+                .copy_from(&self.dv[k]);
+        }
+        for c in &self.couplers {
+            let bodies = self.coupler_bodies(c);
+            let ranges = c.vehicles.map(|k| self.ranges[k].clone());
+            let (n1, n2) = (ranges[0].len(), ranges[1].len());
+            // Γ of both bodies side by side: rows 0–5 body 1 over vehicle 1's
+            // columns, rows 6–11 body 2 over vehicle 2's.
+            let mut gamma = DMatrix::zeros(12, n1 + n2);
+            for (i, range) in ranges.iter().enumerate() {
+                let src = &self.vehicles[c.vehicles[i]].last_evaluation().jacobians;
+                let col0 = if i == 0 { 0 } else { n1 };
+                let n = range.len();
+                gamma
+                    .view_mut((6 * i, col0), (6, n))
+                    .copy_from(&src.view((6 * c.bodies[i], 0), (6, n)));
+            }
+            let mut dq = DMatrix::zeros(n1 + n2, n1 + n2);
+            let mut dv = DMatrix::zeros(n1 + n2, n1 + n2);
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+            };
+            let mut jac = ForceJacobian::new(&gamma, &bodies, &mut dq, &mut dv, &mut self.scratch);
+            c.element.add_jacobian(&ctx, &mut jac)?;
+            let global = |i: usize| {
+                if i < n1 {
+                    ranges[0].start + i
+                } else {
+                    ranges[1].start + i - n1
+                }
+            };
+            for a in 0..n1 + n2 {
+                for b in 0..n1 + n2 {
+                    if dq[(a, b)] != 0.0 {
+                        dfdq[(global(a), global(b))] += dq[(a, b)];
+                    }
+                    if dv[(a, b)] != 0.0 {
+                        dfdv[(global(a), global(b))] += dv[(a, b)];
+                    }
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {
+        for (k, s) in self.vehicles.iter_mut().enumerate() {
+            let r = self.ranges[k].clone();
+            s.accept_step(t, &q[r.clone()], &v[r]);
+        }
+        if let Some(rec) = self.recorder.take() {
+            rec.borrow_mut().flush(self);
+            self.recorder = Some(rec);
+        }
+    }
+}
+
+/// Output rows of a train waiting to be written (see `simulate::Recorder`).
+struct TrainRecorder {
+    /// The reference point's speed law and the offset of the vehicle it
+    /// belongs to (the column `s[m]` is the train's reference arc position).
+    arc: Option<(RunningSpeed, f64)>,
+    columns: Vec<Columns>,
+    pending: std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>,
+    writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
+    rows: usize,
+    values: Vec<f64>,
+    force_values: Vec<f64>,
+    line: String,
+    failure: Option<RunError>,
+}
+
+impl TrainRecorder {
+    fn flush(&mut self, train: &mut TrainSystem) {
+        while let Some((t, q, v)) = self.pending.pop_front() {
+            if self.failure.is_some() {
+                continue;
+            }
+            if let Err(e) = self.write_row(train, t, &q, &v) {
+                self.failure = Some(e);
+            }
+        }
+    }
+
+    fn write_row(
+        &mut self,
+        train: &mut TrainSystem,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<(), RunError> {
+        self.values.clear();
+        self.values.push(t);
+        if let Some((arc, offset)) = &self.arc {
+            use railmbs_track::SpeedLaw;
+            let s = arc
+                .motion(t)
+                .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))?;
+            self.values.push(s.s - offset);
+        }
+        for (k, cols) in self.columns.iter().enumerate() {
+            let r = train.range(k);
+            cols.values(
+                train.vehicle_mut(k),
+                t,
+                &q[r.clone()],
+                &v[r],
+                &mut self.values,
+                &mut self.force_values,
+            )?;
+        }
+        train.coupler_outputs(t, q, v, &mut self.values)?;
+        if let Some((path, w)) = self.writer.as_mut() {
+            use std::fmt::Write as _;
+            self.line.clear();
+            for (k, x) in self.values.iter().enumerate() {
+                if k > 0 {
+                    self.line.push(',');
+                }
+                let _ = write!(self.line, "{x}");
+            }
+            writeln!(w, "{}", self.line).map_err(|source| RunError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        self.rows += 1;
+        Ok(())
+    }
+}
+
+/// A train ready to run: the assembled system, its initial state, the times
+/// at which any vehicle's frames pass a kink of the track, and the output
+/// header.
+pub struct TrainSetup {
+    pub system: TrainSystem,
+    pub q0: Vec<f64>,
+    pub v0: Vec<f64>,
+    pub breakpoints: Vec<f64>,
+    pub header: Vec<String>,
+    columns: Vec<Columns>,
+    arc: Option<(RunningSpeed, f64)>,
+}
+
+/// Builds the train of `train` from its vehicles' models (`models`, in
+/// vehicle order) and engines (one per vehicle, built for its model). Errors
+/// name the train file.
+pub fn build_train(
+    train: &TrainScenario,
+    models: &[&Model],
+    engines: Vec<Box<dyn Equations>>,
+) -> Result<TrainSetup, RunError> {
+    let setup = |message: String| RunError::Setup {
+        file: train.source.clone(),
+        message,
+    };
+    if models.len() != train.vehicles.len() || engines.len() != train.vehicles.len() {
+        return Err(setup(format!(
+            "a train of {} vehicles needs as many models and engines (got {} and {})",
+            train.vehicles.len(),
+            models.len(),
+            engines.len()
+        )));
+    }
+    train
+        .check_names(models)
+        .map_err(|e| setup(e.to_string()))?;
+    let mut vehicles = Vec::new();
+    let mut columns_all = Vec::new();
+    let mut header = vec!["time".to_string(), "s[m]".to_string()];
+    let (mut q0, mut v0, mut breakpoints) = (Vec::new(), Vec::new(), Vec::new());
+    let mut arc = None;
+    // Contact tables built for one vehicle serve the others.
+    let mut tables = Default::default();
+    for (k, (model, engine)) in models.iter().zip(engines).enumerate() {
+        let name = &train.vehicles[k].name;
+        let scenario = train.vehicle_scenario(k, model);
+        let state = scenario_state(&scenario, model)?;
+        let (equations, times, binding) =
+            drive_track_frames(&scenario, model, &state.params, engine)?;
+        let mut system = ModelSystem::new(model, equations, state.params)?;
+        match binding {
+            Some(mut b) => {
+                b.tables = std::mem::take(&mut tables);
+                system.bind_track(&b)?;
+                tables = std::mem::take(&mut b.tables);
+                if arc.is_none() {
+                    arc = Some((b.speed.clone(), train.vehicles[k].offset));
+                }
+            }
+            None => {
+                if let Some(f) = system.forces().iter().find(|f| f.needs_track()) {
+                    return Err(setup(format!(
+                        "vehicle \"{name}\": force element \"{}\" needs a track: put its \
+                         wheelset on a track-following frame",
+                        f.name()
+                    )));
+                }
+            }
+        }
+        let cols = columns(model, &system, &scenario.output, &train.source, None)?;
+        header.extend(cols.header.iter().skip(1).map(|h| format!("{name}.{h}")));
+        columns_all.push(cols);
+        q0.extend(state.q);
+        v0.extend(state.v);
+        breakpoints.extend(times);
+        vehicles.push((name.clone(), system));
+    }
+    breakpoints.sort_by(f64::total_cmp);
+    breakpoints.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let mut couplers = Vec::new();
+    for c in &train.couplers {
+        let (b1, b2) = train
+            .resolve_coupler(c, models)
+            .map_err(|e| setup(e.to_string()))?;
+        let coupler = Coupler::new(c, b1, b2)?;
+        header.extend(
+            coupler
+                .output_names()
+                .iter()
+                .map(|s| format!("{}.{s}", c.name)),
+        );
+        couplers.push(coupler);
+    }
+    if arc.is_none() {
+        header.remove(1);
+    }
+    Ok(TrainSetup {
+        system: TrainSystem::new(vehicles, couplers)?,
+        q0,
+        v0,
+        breakpoints,
+        header,
+        columns: columns_all,
+        arc,
+    })
+}
+
+/// Runs the train scenario `train` (vehicles' models and engines in vehicle
+/// order) and writes the output CSV to `output` (if given): columns `time`,
+/// `s[m]` (the train's reference point), then each vehicle's columns prefixed
+/// by its name (`Coach2.Bogie1.WS1.contact.L.Q[N]`), then the couplers'
+/// forces (`C12.Fx[N]` …). As [`crate::simulate::run_scenario`] otherwise.
+pub fn run_train(
+    train: &TrainScenario,
+    models: &[&Model],
+    engines: Vec<Box<dyn Equations>>,
+    output: Option<&Path>,
+    mut progress: impl FnMut(f64),
+) -> Result<RunSummary, RunError> {
+    let mut names: Vec<String> = Vec::new();
+    for e in &engines {
+        if !names.iter().any(|n| n == e.engine_name()) {
+            names.push(e.engine_name().to_string());
+        }
+    }
+    let TrainSetup {
+        mut system,
+        q0,
+        v0,
+        breakpoints,
+        header,
+        columns,
+        arc,
+    } = build_train(train, models, engines)?;
+    let writer = match output {
+        Some(p) => {
+            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir).map_err(|source| RunError::Io {
+                    path: dir.to_path_buf(),
+                    source,
+                })?;
+            }
+            let f = std::fs::File::create(p).map_err(|source| RunError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?;
+            let mut w = std::io::BufWriter::new(f);
+            writeln!(w, "{}", header.join(",")).map_err(|source| RunError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?;
+            Some((p.to_path_buf(), w))
+        }
+        None => None,
+    };
+    let recorder = Rc::new(RefCell::new(TrainRecorder {
+        arc,
+        columns,
+        pending: Default::default(),
+        writer,
+        rows: 0,
+        values: Vec::new(),
+        force_values: Vec::new(),
+        line: String::new(),
+        failure: None,
+    }));
+    system.recorder = Some(recorder.clone());
+
+    let t_end = train.end_time;
+    let interval = train.output.interval;
+    let n = q0.len();
+    let mut prev: Option<StepEnd> = None;
+    let mut next_row = 0usize;
+    let mut last_progress = Instant::now();
+    let mut calls = 0u64;
+    let start = Instant::now();
+    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
+        let mut rec = recorder.borrow_mut();
+        if rec.failure.is_some() {
+            return ControlFlow::Break(());
+        }
+        loop {
+            let mut to = next_row as f64 * interval;
+            let is_last = to >= t_end * (1.0 - 1e-12);
+            if is_last {
+                to = t_end;
+            }
+            let reached = to <= t + 1e-12 * t_end.max(1.0);
+            if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
+                break;
+            }
+            let (qi, vi) = match &prev {
+                Some((t0, q0, v0, a0)) if to < t => (
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
+                        .collect(),
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
+                        .collect(),
+                ),
+                _ => (q.to_vec(), v.to_vec()),
+            };
+            rec.pending.push_back((to, qi, vi));
+            next_row += 1;
+            if is_last {
+                break;
+            }
+        }
+        match &mut prev {
+            Some(p) => {
+                p.0 = t;
+                p.1.copy_from_slice(q);
+                p.2.copy_from_slice(v);
+                p.3.copy_from_slice(a);
+            }
+            None => prev = Some((t, q.to_vec(), v.to_vec(), a.to_vec())),
+        }
+        calls += 1;
+        if calls.is_multiple_of(64) && last_progress.elapsed().as_millis() > 100 {
+            progress(t);
+            last_progress = Instant::now();
+        }
+        ControlFlow::Continue(())
+    };
+    let mut summary = RunSummary {
+        engine: names.join("+"),
+        t_end: 0.0,
+        steps: 0,
+        rejected_steps: 0,
+        newton_iterations: 0,
+        jacobian_evaluations: 0,
+        dynamics_evaluations: 0,
+        cpu_time: 0.0,
+        rows: 0,
+        error: None,
+        assessment: Vec::new(),
+    };
+    let (mut t0, mut q, mut v) = (0.0, q0.clone(), v0.clone());
+    for (k, &breakpoint) in breakpoints.iter().chain([&t_end]).enumerate() {
+        let last = k == breakpoints.len();
+        let segment_end = if last {
+            t_end
+        } else {
+            breakpoint - breakpoint_gap(breakpoint)
+        };
+        let st = match run_integrator(
+            &mut system,
+            &train.integrator,
+            t0,
+            &q,
+            &v,
+            segment_end,
+            &mut observer,
+        ) {
+            Ok(st) => st,
+            Err(e) => {
+                summary.error = Some(e);
+                break;
+            }
+        };
+        summary.add_segment(&st);
+        if st.stopped_by_observer || last {
+            break;
+        }
+        q.copy_from_slice(st.q.as_slice());
+        t0 = breakpoint + breakpoint_gap(breakpoint);
+        // Each vehicle keeps its bodies' absolute velocities across the kink.
+        let mut failed = None;
+        for kv in 0..system.vehicle_count() {
+            let r = system.range(kv);
+            match continuous_velocities(
+                system.vehicle_mut(kv),
+                st.t,
+                t0,
+                &q[r.clone()],
+                &st.v.as_slice()[r.clone()],
+            ) {
+                Ok(vn) => v[r].copy_from_slice(&vn),
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        if let Some(e) = failed {
+            summary.error = Some(e);
+            break;
+        }
+    }
+
+    let cpu_time = start.elapsed().as_secs_f64();
+    system.recorder = None;
+    let mut rec = recorder.borrow_mut();
+    rec.flush(&mut system);
+    if let Some((path, mut w)) = rec.writer.take() {
+        w.flush().map_err(|source| RunError::Io { path, source })?;
+    }
+    if let Some(e) = rec.failure.take() {
+        return Err(e);
+    }
+    match &summary.error {
+        Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
+            summary.t_end = *t;
+        }
+        Some(_) => summary.t_end = prev.as_ref().map_or(summary.t_end, |p| p.0),
+        None => {}
+    }
+    summary.cpu_time = cpu_time;
+    summary.rows = rec.rows;
+    summary.assessment = system.assessment();
+    Ok(summary)
+}
