@@ -1,0 +1,366 @@
+//! Trains: several vehicles on one track coupled by couplers
+//! (`railmbs_runtime::train`).
+
+mod common;
+
+use common::*;
+use railmbs_models::{Model, TrainScenario, load_model, load_scenario, parse_train};
+use railmbs_runtime::train::run_train;
+use railmbs_runtime::{Equations, MechanicalSystem, NumericEquations};
+use std::path::Path;
+
+/// Columns of a CSV output by name.
+struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Table {
+    fn read(path: &Path) -> Table {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        Table { header, rows }
+    }
+    fn col(&self, name: &str) -> Vec<f64> {
+        let k = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"));
+        self.rows.iter().map(|r| r[k]).collect()
+    }
+}
+
+/// A train file written to `dir` (paths in it are absolute).
+fn train_from_text(dir: &Path, text: &str) -> TrainScenario {
+    let path = dir.join("train.ron");
+    std::fs::write(&path, text).unwrap();
+    parse_train(text, &path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn path_text(rel: &str) -> String {
+    model_path(rel).display().to_string()
+}
+
+/// Runs a train with one engine per vehicle made by `engine`; returns the
+/// output table and the summary.
+fn run(
+    train: &TrainScenario,
+    engine: impl Fn(&Model) -> Box<dyn Equations>,
+    out: &Path,
+) -> (Table, railmbs_runtime::simulate::RunSummary) {
+    let models: Vec<Model> = train
+        .vehicles
+        .iter()
+        .map(|v| load_model(&v.model).unwrap())
+        .collect();
+    let refs: Vec<&Model> = models.iter().collect();
+    let engines = models.iter().map(&engine).collect();
+    let summary = run_train(train, &refs, engines, Some(out), |_| {}).unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    (Table::read(out), summary)
+}
+
+fn numeric(model: &Model) -> Box<dyn Equations> {
+    Box::new(NumericEquations::new(model))
+}
+
+/// A train of one vehicle without couplers runs exactly the plain scenario of
+/// that vehicle (same engine): Vehicle 1 at 55 m/s entering lateral
+/// irregularities.
+#[test]
+fn a_train_of_one_vehicle_runs_the_plain_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scenario = load_scenario(&model_path("scenarios/vehicle1_straight_55.ron")).unwrap();
+    scenario.end_time = 0.8;
+    scenario.output.coordinates = true;
+    scenario.output.velocities = true;
+    let model = load_model(&scenario.model).unwrap();
+    let plain_out = dir.path().join("plain.csv");
+    let plain = railmbs_runtime::simulate::run_scenario(
+        &scenario,
+        &model,
+        numeric(&model),
+        Some(&plain_out),
+        |_| {},
+    )
+    .unwrap();
+    assert!(plain.error.is_none());
+    let train = train_from_text(
+        dir.path(),
+        &format!(
+            r#"Train(
+                vehicles: [Vehicle(name: "V", model: "{}", parameters: {{ "v0": 55.0 }})],
+                track: (file: "{}", start: 20.0, speed: 55.0),
+                end_time: 0.8,
+                integrator: Park(rtol: 1e-4, atol: 1e-6, max_step: 0.005),
+                output: (interval: 0.005, velocities: true),
+            )"#,
+            path_text("vehicles/vehicle1.ron"),
+            path_text("tracks/straight_lateral_irregularity.ron"),
+        ),
+    );
+    let (t, summary) = run(&train, numeric, &dir.path().join("train.csv"));
+    assert_eq!(summary.steps, plain.steps);
+    let p = Table::read(&plain_out);
+    assert_eq!(t.rows.len(), p.rows.len());
+    let mut worst: f64 = 0.0;
+    let mut moved: f64 = 0.0;
+    for c in &model.coordinates {
+        for name in [c.name.clone(), format!("{}.v", c.name)] {
+            let a = p.col(&name);
+            let b = t.col(&format!("V.{name}"));
+            for (x, y) in a.iter().zip(&b) {
+                worst = worst.max((x - y).abs() / x.abs().max(1e-3));
+            }
+            if name == "body.y" {
+                moved = a.iter().fold(0.0, |m, x| m.max(x.abs()));
+            }
+        }
+    }
+    assert!(moved > 1e-5, "the irregularity should move the car body");
+    assert!(worst < 1e-9, "largest relative difference {worst:e}");
+}
+
+/// Two free bodies on track frames (no gravity, no other forces) coupled by
+/// a coupler on straight track: the coupler is internal, the total linear
+/// momentum stays what it was (RK4 keeps linear invariants to rounding; Park
+/// to its Newton tolerance), while the coupler force swings by kilonewtons.
+#[test]
+fn couplers_conserve_the_total_linear_momentum() {
+    let dir = tempfile::tempdir().unwrap();
+    for integrator in [
+        "Rk4(step: 0.001)",
+        "Park(rtol: 1e-8, atol: 1e-10, max_step: 0.01)",
+    ] {
+        let train = train_from_text(
+            dir.path(),
+            &format!(
+                r#"Train(
+                vehicles: [
+                    Vehicle(name: "A", model: "{car}", offset: 0.0,
+                            initial: [(coord: "body.x", velocity: 0.5), (coord: "body.rz", velocity: 0.1)]),
+                    Vehicle(name: "B", model: "{car}", offset: -10.0, parameters: {{ "m": 3000.0 }},
+                            initial: [(coord: "body.y", velocity: -0.2), (coord: "body.z", velocity: 0.1)]),
+                ],
+                couplers: [
+                    Coupler(name: "AB", body1: "A.body", point1: (-5.0, 0.0, 0.3),
+                            body2: "B.body", point2: (5.0, 0.0, 0.3),
+                            stiffness: (1e5, 2e4, 3e4), damping: (1e3, 500.0, 500.0),
+                            angular_stiffness: (1e4, 1e4, 1e4), preload: (200.0, 0.0, 0.0)),
+                ],
+                track: (file: "{track}", start: 100.0, speed: 10.0),
+                end_time: 2.0,
+                integrator: {integrator},
+                output: (interval: 0.05, bodies: ["*"]),
+            )"#,
+                car = path_text("vehicles/train/track_car.ron"),
+                track = path_text("tracks/straight.ron"),
+            ),
+        );
+        let (t, _) = run(&train, numeric, &dir.path().join("out.csv"));
+        let (ma, mb) = (1000.0, 3000.0);
+        let fx = t.col("AB.Fx[N]");
+        assert!(fx.iter().fold(0.0_f64, |m, f| m.max(f.abs())) > 1e3);
+        let tol = if integrator.starts_with("Rk4") {
+            1e-11
+        } else {
+            1e-7
+        };
+        for axis in ["x", "y", "z"] {
+            let a = t.col(&format!("A.body.v{axis}[m/s]"));
+            let b = t.col(&format!("B.body.v{axis}[m/s]"));
+            let p: Vec<f64> = a.iter().zip(&b).map(|(x, y)| ma * x + mb * y).collect();
+            let scale = ma * 10.0;
+            for pi in &p {
+                assert!(
+                    (pi - p[0]).abs() < tol * scale,
+                    "{integrator}: momentum along {axis} {pi} vs {} at start",
+                    p[0]
+                );
+            }
+        }
+    }
+}
+
+/// Three coaches from the bundled train file, numeric engine.
+fn train3(end_time: f64) -> TrainScenario {
+    let mut train =
+        railmbs_models::load_train(&model_path("scenarios/train3_straight.ron")).unwrap();
+    train.end_time = end_time;
+    train.output.coordinates = true;
+    train
+}
+
+/// The symmetric three-coach train on perfect straight track stays centred:
+/// every lateral displacement and yaw angle of the 126 coordinates and the
+/// couplers' lateral forces stay at rounding level.
+#[test]
+fn a_symmetric_train_on_straight_track_stays_centred() {
+    let dir = tempfile::tempdir().unwrap();
+    let train = train3(3.0);
+    let (t, summary) = run(&train, numeric, &dir.path().join("out.csv"));
+    let models: Vec<Model> = train
+        .vehicles
+        .iter()
+        .map(|v| load_model(&v.model).unwrap())
+        .collect();
+    assert_eq!(
+        models.iter().map(|m| m.coordinates.len()).sum::<usize>(),
+        126
+    );
+    assert_eq!(summary.assessment.len(), 3 * 4 * 5);
+    let mut worst: f64 = 0.0;
+    for (v, m) in train.vehicles.iter().zip(&models) {
+        for c in m
+            .coordinates
+            .iter()
+            .filter(|c| c.name.ends_with(".y") || c.name.ends_with(".rz"))
+        {
+            let col = t.col(&format!("{}.{}", v.name, c.name));
+            worst = col.iter().fold(worst, |w, x| w.max(x.abs()));
+        }
+    }
+    assert!(
+        worst < 1e-9,
+        "largest lateral displacement or yaw {worst:e}"
+    );
+    for c in ["C12", "C23"] {
+        let fy = t.col(&format!("{c}.Fy[N]"));
+        assert!(fy.iter().all(|f| f.abs() < 1e-3), "{c}: lateral force");
+    }
+    // The coaches keep their places along the track (26 m apart).
+    let x1 = t.col("Coach1.body.x[m]");
+    let x3 = t.col("Coach3.body.x[m]");
+    for (a, b) in x1.iter().zip(&x3) {
+        assert!((a - b - 52.0).abs() < 1e-3);
+    }
+}
+
+/// At the initial state of the three-coach train the blocks of the analytic
+/// Jacobian between vehicles (couplers only) match finite differences of
+/// the generalized forces.
+#[test]
+fn the_coupler_jacobian_matches_finite_differences() {
+    let train = train3(1.0);
+    let models: Vec<Model> = train
+        .vehicles
+        .iter()
+        .map(|v| load_model(&v.model).unwrap())
+        .collect();
+    let refs: Vec<&Model> = models.iter().collect();
+    let engines = models.iter().map(numeric).collect();
+    let mut setup = railmbs_runtime::train::build_train(&train, &refs, engines).unwrap();
+    let n = setup.system.dof();
+    // Perturb the state a little so that couplers deflect.
+    let mut rng = Rng::new(7);
+    let mut q = setup.q0.clone();
+    let mut v = setup.v0.clone();
+    for (qi, vi) in q.iter_mut().zip(v.iter_mut()) {
+        *qi += rng.uniform(-1e-5, 1e-5);
+        *vi += rng.uniform(-1e-4, 1e-4);
+    }
+    let sys = &mut setup.system;
+    let (mut dq, mut dv) = (
+        nalgebra::DMatrix::zeros(n, n),
+        nalgebra::DMatrix::zeros(n, n),
+    );
+    assert!(sys.force_jacobian(0.1, &q, &v, &mut dq, &mut dv).unwrap());
+    let mut mass = nalgebra::DMatrix::zeros(n, n);
+    let mut f0 = nalgebra::DVector::zeros(n);
+    let mut f1 = nalgebra::DVector::zeros(n);
+    let r1 = sys.range(0);
+    let r2 = sys.range(1);
+    let (mut worst, mut scale): (f64, f64) = (0.0, 0.0);
+    for j in r2.clone() {
+        for (which, h) in [(0, 1e-8), (1, 1e-7)] {
+            let (mut qp, mut vp) = (q.clone(), v.clone());
+            let (mut qm, mut vm) = (q.clone(), v.clone());
+            if which == 0 {
+                qp[j] += h;
+                qm[j] -= h;
+            } else {
+                vp[j] += h;
+                vm[j] -= h;
+            }
+            sys.dynamics(0.1, &qp, &vp, &mut mass, &mut f1).unwrap();
+            sys.dynamics(0.1, &qm, &vm, &mut mass, &mut f0).unwrap();
+            let analytic = if which == 0 { &dq } else { &dv };
+            for i in r1.clone() {
+                let fd = (f1[i] - f0[i]) / (2.0 * h);
+                worst = worst.max((fd - analytic[(i, j)]).abs());
+                scale = scale.max(fd.abs());
+            }
+        }
+    }
+    assert!(scale > 1e4, "couplers should couple the vehicles: {scale}");
+    assert!(
+        worst < 1e-3 * scale,
+        "largest difference {worst} (largest entry {scale})"
+    );
+    // Vehicles 1 and 3 are not coupled directly.
+    let r3 = sys.range(2);
+    for i in r1 {
+        for j in r3.clone() {
+            assert_eq!(dq[(i, j)], 0.0);
+        }
+    }
+}
+
+/// The symbolic plugin (one per model file, shared by the three coaches) and
+/// the numeric engine run the same three-coach train into a lateral
+/// irregularity to the integration tolerance.
+#[test]
+fn symbolic_and_numeric_engines_agree_on_a_train() {
+    let dir = tempfile::tempdir().unwrap();
+    // Straight track with a lateral sinusoid (20 m, 3 mm) from s = 115 m,
+    // which the leading coach enters after 0.14 s.
+    let track = dir.path().join("track.ron");
+    std::fs::write(
+        &track,
+        "Custom((sections: [Straight(length: 1000.0)], irregularities: [\
+         Sinusoid(component: Lateral, wavelength: 20.0, amplitude: 0.003, start: 115.0, end: 900.0)]))",
+    )
+    .unwrap();
+    let mut train = train3(1.0);
+    train.track.file = track;
+    let (a, _) = run(&train, numeric, &dir.path().join("numeric.csv"));
+    let (b, summary) = run(
+        &train,
+        |m| Box::new(symbolic_engine(m)),
+        &dir.path().join("symbolic.csv"),
+    );
+    assert_eq!(summary.engine, "symbolic");
+    assert_eq!(a.header, b.header);
+    for (coach, least) in [("Coach1", 1e-4), ("Coach2", 1e-7)] {
+        let y = a.col(&format!("{coach}.body.y[m]"));
+        let most = y.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        assert!(most > least, "{coach} moves laterally by {most:e} m only");
+    }
+    // Coordinates (m, rad) against the integrator's tolerances (rtol 1e-4,
+    // atol 1e-6): the error of each engine's run is estimated to those; the
+    // engines agree to rounding on the equations.
+    let (mut worst, mut which) = (0.0_f64, String::new());
+    for (ra, rb) in a.rows.iter().zip(&b.rows) {
+        for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
+            if a.header[k].ends_with(']') || a.header[k] == "time" {
+                continue;
+            }
+            let e = (x - y).abs() / (1e-6 + 1e-4 * x.abs());
+            if e > worst {
+                (worst, which) = (e, a.header[k].clone());
+            }
+        }
+    }
+    eprintln!("largest difference {worst} tolerances ({which})");
+    assert!(worst < 1.0, "{which}: difference {worst} tolerances");
+}
