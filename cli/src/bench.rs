@@ -305,7 +305,9 @@ impl BenchReport {
             (
                 "steps of the run",
                 self.numeric.run_steps.map_or("-".into(), |n| n.to_string()),
-                self.symbolic.run_steps.map_or("-".into(), |n| n.to_string()),
+                self.symbolic
+                    .run_steps
+                    .map_or("-".into(), |n| n.to_string()),
                 String::new(),
             ),
             (
@@ -558,7 +560,11 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
             }
         }
         if !found {
-            return Err(format!("--creep: model {} has no wheel–rail element", args.model.display()).into());
+            return Err(format!(
+                "--creep: model {} has no wheel–rail element",
+                args.model.display()
+            )
+            .into());
         }
     }
     let (scenario, scenario_note) = match &args.scenario {
