@@ -364,3 +364,56 @@ fn symbolic_and_numeric_engines_agree_on_a_train() {
     eprintln!("largest difference {worst} tolerances ({which})");
     assert!(worst < 1.0, "{which}: difference {worst} tolerances");
 }
+
+/// Mistakes in a train file are reported with the file, the element and the
+/// line and column: an unknown vehicle in a coupler (when read), an unknown
+/// body of a known vehicle and an unknown train-wide parameter (when built).
+#[test]
+fn train_file_errors_name_the_element_and_position() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = |body1: &str, parameter: &str| {
+        format!(
+            r#"Train(
+    vehicles: [
+        Vehicle(name: "A", model: "{car}"),
+        Vehicle(name: "B", model: "{car}", offset: -10.0),
+    ],
+    couplers: [
+        Coupler(name: "AB", body1: "{body1}", point1: (-5.0, 0.0, 0.0),
+                body2: "B.body", point2: (5.0, 0.0, 0.0), stiffness: (1e5, 1e4, 1e4)),
+    ],
+    parameters: {{ "{parameter}": 900.0 }},
+    track: (file: "{track}", start: 100.0, speed: 10.0),
+    end_time: 1.0,
+    integrator: Rk4(step: 0.001),
+    output: (interval: 0.1),
+)"#,
+            car = path_text("vehicles/train/track_car.ron"),
+            track = path_text("tracks/straight.ron"),
+        )
+    };
+    let path = dir.path().join("bad.ron");
+    let e = parse_train(&text("C.body", "m"), &path)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.ron:7:"), "{e}");
+    assert!(e.contains("coupler \"AB\""), "{e}");
+    assert!(e.contains("\"C.body\""), "{e}");
+    let build = |text: String| {
+        std::fs::write(&path, &text).unwrap();
+        let train = parse_train(&text, &path).unwrap();
+        let model = load_model(&train.vehicles[0].model).unwrap();
+        let engines = vec![numeric(&model), numeric(&model)];
+        railmbs_runtime::train::build_train(&train, &[&model, &model], engines)
+            .err()
+            .expect("an error")
+            .to_string()
+    };
+    let e = build(text("A.bdy", "m"));
+    assert!(e.contains("bad.ron:7:"), "{e}");
+    assert!(e.contains("coupler \"AB\""), "{e}");
+    assert!(e.contains("no body \"bdy\""), "{e}");
+    let e = build(text("A.body", "mass"));
+    assert!(e.contains("bad.ron:10:"), "{e}");
+    assert!(e.contains("parameter \"mass\""), "{e}");
+}
