@@ -457,8 +457,13 @@ impl WheelRailContact {
         let ey = n.cross(&ex);
         let rho = point - body.position;
         let v_wheel = body.velocity + body.angular_velocity.cross(&rho);
-        // Approach rate: the wheel point moving against the normal.
-        let approach_rate = -v_wheel.dot(&n);
+        // Approach rate: the wheel's surface moving against the normal at the
+        // contact point. The spin about the axle only rolls the surface
+        // through the contact (its material velocity there has a normal
+        // component Ω x_c when the contact leads the axle plane by x_c, e.g.
+        // on a yawed flange), so the approach uses the non-spinning motion.
+        let omega_frame = body.angular_velocity - *axle * body.angular_velocity.dot(axle);
+        let approach_rate = -(body.velocity + omega_frame.cross(&rho)).dot(&n);
         let normal = (elastic + self.c.normal_damping * approach_rate).max(0.0);
         if normal == 0.0 {
             return Ok(ContactState::default());
