@@ -95,46 +95,52 @@ fn a_train_of_one_vehicle_runs_the_plain_scenario() {
     )
     .unwrap();
     assert!(plain.error.is_none());
-    let train = train_from_text(
-        dir.path(),
-        &format!(
-            r#"Train(
-                vehicles: [Vehicle(name: "V", model: "{}", parameters: {{ "v0": 55.0 }})],
-                track: (file: "{}", start: 20.0, speed: 55.0),
+    let p = Table::read(&plain_out);
+    // The vehicle at the train's reference point, and 26 m behind it with the
+    // reference point 26 m further on: the same track under the same wheels.
+    for (offset, start) in [(0.0, 20.0), (-26.0, 46.0)] {
+        let train = train_from_text(
+            dir.path(),
+            &format!(
+                r#"Train(
+                vehicles: [Vehicle(name: "V", model: "{}", offset: {offset:?},
+                                   parameters: {{ "v0": 55.0 }})],
+                track: (file: "{}", start: {start:?}, speed: 55.0),
                 end_time: 0.8,
                 integrator: Park(rtol: 1e-4, atol: 1e-6, max_step: 0.005),
                 output: (interval: 0.005, velocities: true),
             )"#,
-            path_text("vehicles/vehicle1.ron"),
-            path_text("tracks/straight_lateral_irregularity.ron"),
-        ),
-    );
-    let (t, summary) = run(&train, numeric, &dir.path().join("train.csv"));
-    assert_eq!(summary.steps, plain.steps);
-    let p = Table::read(&plain_out);
-    assert_eq!(t.rows.len(), p.rows.len());
-    let mut worst: f64 = 0.0;
-    let mut moved: f64 = 0.0;
-    for c in &model.coordinates {
-        for name in [c.name.clone(), format!("{}.v", c.name)] {
-            let a = p.col(&name);
-            let b = t.col(&format!("V.{name}"));
-            for (x, y) in a.iter().zip(&b) {
-                worst = worst.max((x - y).abs() / x.abs().max(1e-3));
-            }
-            if name == "body.y" {
-                moved = a.iter().fold(0.0, |m, x| m.max(x.abs()));
+                path_text("vehicles/vehicle1.ron"),
+                path_text("tracks/straight_lateral_irregularity.ron"),
+            ),
+        );
+        let (t, summary) = run(&train, numeric, &dir.path().join("train.csv"));
+        assert_eq!(summary.steps, plain.steps);
+        assert_eq!(t.rows.len(), p.rows.len());
+        let mut worst: f64 = 0.0;
+        let mut moved: f64 = 0.0;
+        for c in &model.coordinates {
+            for name in [c.name.clone(), format!("{}.v", c.name)] {
+                let a = p.col(&name);
+                let b = t.col(&format!("V.{name}"));
+                for (x, y) in a.iter().zip(&b) {
+                    worst = worst.max((x - y).abs() / x.abs().max(1e-3));
+                }
+                if name == "body.y" {
+                    moved = a.iter().fold(0.0, |m, x| m.max(x.abs()));
+                }
             }
         }
+        assert!(moved > 1e-5, "the irregularity should move the car body");
+        assert!(
+            worst < 1e-9,
+            "offset {offset}: largest relative difference {worst:e}"
+        );
+        // The column s[m] is the train's reference point.
+        assert_eq!(t.col("s[m]")[0], start);
     }
-    assert!(moved > 1e-5, "the irregularity should move the car body");
-    assert!(worst < 1e-9, "largest relative difference {worst:e}");
 }
 
-/// Two free bodies on track frames (no gravity, no other forces) coupled by
-/// a coupler on straight track: the coupler is internal, the total linear
-/// momentum stays what it was (RK4 keeps linear invariants to rounding; Park
-/// to its Newton tolerance), while the coupler force swings by kilonewtons.
 #[test]
 fn couplers_conserve_the_total_linear_momentum() {
     let dir = tempfile::tempdir().unwrap();
