@@ -64,6 +64,9 @@ pub const MIN_ROLLING_SPEED: f64 = 0.1;
 /// where Hertz's theory does not apply.
 const MIN_CURVATURE_RATIO: f64 = 1.0 / 25.0;
 
+/// Largest tan δ used for the contact's lead ahead of the axle plane (75°).
+const MAX_LEAD_TAN: f64 = 3.73;
+
 /// The scenario's track, as the wheel–rail elements see it.
 pub struct TrackBinding {
     /// The track.
@@ -447,7 +450,15 @@ impl WheelRailContact {
         let normal_stiffness = shape.stiffness(approach);
         // Contact point on the (displaced) rail, in the track frame then SC0.
         let local = Vector3::new(
-            x_rel + c.longitudinal_offset(yaw),
+            // Overswing of the contact ahead of the axle plane, r tan δ ψ
+            // (small ψ), with tan δ bounded by the steepest real flange
+            // (75°): a region's deepest point on the region boundary can
+            // carry a meaningless near-vertical slope.
+            x_rel
+                + (c.yaw_lead.clamp(
+                    -MAX_LEAD_TAN * c.rolling_radius,
+                    MAX_LEAD_TAN * c.rolling_radius,
+                )) * yaw,
             c.rail_y + dy,
             c.rail_z + dz,
         );
