@@ -74,13 +74,19 @@ fn assert_static(model: &Model, t: &Table) {
     for ws in ["WS1", "WS2"] {
         for side in ["L", "R"] {
             for q in t.col(&format!("{ws}.contact.{side}.Q [N]")) {
-                assert!((q - wheel).abs() < 0.01 * wheel, "{ws} {side}: Q {q} N vs {wheel} N");
+                assert!(
+                    (q - wheel).abs() < 0.01 * wheel,
+                    "{ws} {side}: Q {q} N vs {wheel} N"
+                );
             }
         }
     }
     for s in ["Spring1Left", "Spring1Right", "Spring2Left", "Spring2Right"] {
         for f in t.col(&format!("{s}.F[N]")) {
-            assert!((f - spring).abs() < 0.01 * spring, "{s}: {f} N vs {spring} N");
+            assert!(
+                (f - spring).abs() < 0.01 * spring,
+                "{s}: {f} N vs {spring} N"
+            );
         }
     }
 }
