@@ -440,7 +440,7 @@ pub(crate) fn run_integrator<S: crate::system::MechanicalSystem>(
 /// outputs, so the file grows while the run goes on.
 pub(crate) struct Recorder {
     columns: Columns,
-    pending: std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>,
+    pending: PendingRows,
     writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
     rows: usize,
     values: Vec<f64>,
@@ -501,6 +501,99 @@ impl Recorder {
 }
 
 /// Runs `scenario` on `model` with the engine `equations` and writes the output
+/// The output grid of a run: rows at k·interval (and always at the end
+/// time), interpolated from the accepted steps by cubic Hermite
+/// interpolation, plus the progress callback now and then. Called once per
+/// accepted step by the integrator's observer.
+pub(crate) struct OutputSchedule {
+    t_end: f64,
+    interval: f64,
+    n: usize,
+    /// The previous accepted step's end (t, q, q̇, q̈).
+    prev: Option<StepEnd>,
+    next_row: usize,
+    last_progress: Instant,
+    calls: u64,
+}
+
+/// Rows waiting to be written: (t, q, q̇).
+pub(crate) type PendingRows = std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>;
+
+impl OutputSchedule {
+    pub(crate) fn new(t_end: f64, interval: f64, n: usize) -> Self {
+        Self {
+            t_end,
+            interval,
+            n,
+            prev: None,
+            next_row: 0,
+            last_progress: Instant::now(),
+            calls: 0,
+        }
+    }
+
+    /// Queues the output rows in (t_prev, t] after an accepted step ending at
+    /// (t, q, q̇, q̈); the end time is always the last row.
+    pub(crate) fn observe(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        pending: &mut PendingRows,
+        progress: &mut impl FnMut(f64),
+    ) {
+        let (t_end, n) = (self.t_end, self.n);
+        loop {
+            let mut to = self.next_row as f64 * self.interval;
+            let is_last = to >= t_end * (1.0 - 1e-12);
+            if is_last {
+                to = t_end;
+            }
+            let reached = to <= t + 1e-12 * t_end.max(1.0);
+            if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
+                break;
+            }
+            let (qi, vi) = match &self.prev {
+                Some((t0, q0, v0, a0)) if to < t => (
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
+                        .collect(),
+                    (0..n)
+                        .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
+                        .collect(),
+                ),
+                _ => (q.to_vec(), v.to_vec()),
+            };
+            pending.push_back((to, qi, vi));
+            self.next_row += 1;
+            if is_last {
+                break;
+            }
+        }
+        match &mut self.prev {
+            Some(p) => {
+                p.0 = t;
+                p.1.copy_from_slice(q);
+                p.2.copy_from_slice(v);
+                p.3.copy_from_slice(a);
+            }
+            None => self.prev = Some((t, q.to_vec(), v.to_vec(), a.to_vec())),
+        }
+        // The clock is read every 64 steps only: this runs once per step.
+        self.calls += 1;
+        if self.calls.is_multiple_of(64) && self.last_progress.elapsed().as_millis() > 100 {
+            progress(t);
+            self.last_progress = Instant::now();
+        }
+    }
+
+    /// The previous accepted step's end time, if any.
+    pub(crate) fn last_time(&self) -> Option<f64> {
+        self.prev.as_ref().map(|p| p.0)
+    }
+}
+
 /// CSV to `output` (if given). `progress` is called with the simulated time
 /// now and then. A simulation error stops the run: rows up to that point are
 /// written, and the summary carries the error.
@@ -571,62 +664,14 @@ pub fn run_scenario(
     system.set_recorder(Some(recorder.clone()));
 
     let t_end = scenario.end_time;
-    let interval = scenario.output.interval;
-    let n = q0.len();
-    // The previous accepted step's end (t, q, q̇, q̈), for Hermite interpolation.
-    let mut prev: Option<StepEnd> = None;
-    let mut next_row = 0usize;
-    let mut last_progress = Instant::now();
-    let mut calls = 0u64;
+    let mut schedule = OutputSchedule::new(t_end, scenario.output.interval, q0.len());
     let start = Instant::now();
     let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
         let mut rec = recorder.borrow_mut();
         if rec.failure.is_some() {
             return ControlFlow::Break(());
         }
-        // Output times k·interval in (t_prev, t]; the end time is always the last row.
-        loop {
-            let mut to = next_row as f64 * interval;
-            let is_last = to >= t_end * (1.0 - 1e-12);
-            if is_last {
-                to = t_end;
-            }
-            let reached = to <= t + 1e-12 * t_end.max(1.0);
-            if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
-                break;
-            }
-            let (qi, vi) = match &prev {
-                Some((t0, q0, v0, a0)) if to < t => (
-                    (0..n)
-                        .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
-                        .collect(),
-                    (0..n)
-                        .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
-                        .collect(),
-                ),
-                _ => (q.to_vec(), v.to_vec()),
-            };
-            rec.pending.push_back((to, qi, vi));
-            next_row += 1;
-            if is_last {
-                break;
-            }
-        }
-        match &mut prev {
-            Some(p) => {
-                p.0 = t;
-                p.1.copy_from_slice(q);
-                p.2.copy_from_slice(v);
-                p.3.copy_from_slice(a);
-            }
-            None => prev = Some((t, q.to_vec(), v.to_vec(), a.to_vec())),
-        }
-        // The clock is read every 64 steps only: the observer runs once per step.
-        calls += 1;
-        if calls.is_multiple_of(64) && last_progress.elapsed().as_millis() > 100 {
-            progress(t);
-            last_progress = Instant::now();
-        }
+        schedule.observe(t, q, v, a, &mut rec.pending, &mut progress);
         ControlFlow::Continue(())
     };
     // Integrate from breakpoint to breakpoint (kinks of the track), restarting
@@ -696,7 +741,7 @@ pub fn run_scenario(
         Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
             summary.t_end = *t;
         }
-        Some(_) => summary.t_end = prev.as_ref().map_or(summary.t_end, |p| p.0),
+        Some(_) => summary.t_end = schedule.last_time().unwrap_or(summary.t_end),
         None => {}
     }
     summary.cpu_time = cpu_time;

@@ -24,8 +24,8 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, RunError, RunSummary, StepEnd, breakpoint_gap, columns, continuous_velocities,
-    drive_track_frames, hermite, run_integrator, scenario_state,
+    Columns, OutputSchedule, PendingRows, RunError, RunSummary, breakpoint_gap, columns,
+    continuous_velocities, drive_track_frames, run_integrator, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
@@ -439,7 +439,7 @@ struct TrainRecorder {
     /// belongs to (the column `s[m]` is the train's reference arc position).
     arc: Option<(RunningSpeed, f64)>,
     columns: Vec<Columns>,
-    pending: std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>,
+    pending: PendingRows,
     writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
     rows: usize,
     values: Vec<f64>,
@@ -676,59 +676,14 @@ pub fn run_train(
     system.recorder = Some(recorder.clone());
 
     let t_end = train.end_time;
-    let interval = train.output.interval;
-    let n = q0.len();
-    let mut prev: Option<StepEnd> = None;
-    let mut next_row = 0usize;
-    let mut last_progress = Instant::now();
-    let mut calls = 0u64;
+    let mut schedule = OutputSchedule::new(t_end, train.output.interval, q0.len());
     let start = Instant::now();
     let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
         let mut rec = recorder.borrow_mut();
         if rec.failure.is_some() {
             return ControlFlow::Break(());
         }
-        loop {
-            let mut to = next_row as f64 * interval;
-            let is_last = to >= t_end * (1.0 - 1e-12);
-            if is_last {
-                to = t_end;
-            }
-            let reached = to <= t + 1e-12 * t_end.max(1.0);
-            if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
-                break;
-            }
-            let (qi, vi) = match &prev {
-                Some((t0, q0, v0, a0)) if to < t => (
-                    (0..n)
-                        .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
-                        .collect(),
-                    (0..n)
-                        .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
-                        .collect(),
-                ),
-                _ => (q.to_vec(), v.to_vec()),
-            };
-            rec.pending.push_back((to, qi, vi));
-            next_row += 1;
-            if is_last {
-                break;
-            }
-        }
-        match &mut prev {
-            Some(p) => {
-                p.0 = t;
-                p.1.copy_from_slice(q);
-                p.2.copy_from_slice(v);
-                p.3.copy_from_slice(a);
-            }
-            None => prev = Some((t, q.to_vec(), v.to_vec(), a.to_vec())),
-        }
-        calls += 1;
-        if calls.is_multiple_of(64) && last_progress.elapsed().as_millis() > 100 {
-            progress(t);
-            last_progress = Instant::now();
-        }
+        schedule.observe(t, q, v, a, &mut rec.pending, &mut progress);
         ControlFlow::Continue(())
     };
     let mut summary = RunSummary {
@@ -811,7 +766,7 @@ pub fn run_train(
         Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
             summary.t_end = *t;
         }
-        Some(_) => summary.t_end = prev.as_ref().map_or(summary.t_end, |p| p.0),
+        Some(_) => summary.t_end = schedule.last_time().unwrap_or(summary.t_end),
         None => {}
     }
     summary.cpu_time = cpu_time;
