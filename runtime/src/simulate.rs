@@ -66,6 +66,28 @@ impl RunSummary {
         self.t_end = st.t;
     }
 
+    /// Completes the summary at the end of a run: CPU time, rows written,
+    /// assessment, and the time reached (where a failure occurred, or the
+    /// last accepted step).
+    pub(crate) fn finish(
+        &mut self,
+        cpu_time: f64,
+        rows: usize,
+        last_step: Option<f64>,
+        assessment: Vec<crate::forces::Assessment>,
+    ) {
+        match &self.error {
+            Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
+                self.t_end = *t;
+            }
+            Some(_) => self.t_end = last_step.unwrap_or(self.t_end),
+            None => {}
+        }
+        self.cpu_time = cpu_time;
+        self.rows = rows;
+        self.assessment = assessment;
+    }
+
     /// Simulated seconds per CPU second.
     pub fn realtime_factor(&self) -> f64 {
         self.t_end / self.cpu_time.max(1e-12)
@@ -501,6 +523,52 @@ impl Recorder {
 }
 
 /// Runs `scenario` on `model` with the engine `equations` and writes the output
+/// Integrates from breakpoint to breakpoint (kinks of the track) up to
+/// `t_end`, restarting after each with the velocities `restart` gives
+/// (continuous absolute velocities); adds each segment's counts to `summary`
+/// and stores the first error there.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn integrate_segments<S: crate::system::MechanicalSystem>(
+    system: &mut S,
+    integrator: &IntegratorSpec,
+    (q0, v0): (&[f64], &[f64]),
+    breakpoints: &[f64],
+    t_end: f64,
+    observer: &mut impl FnMut(f64, &[f64], &[f64], &[f64]) -> ControlFlow<()>,
+    summary: &mut RunSummary,
+    mut restart: impl FnMut(&mut S, f64, f64, &[f64], &[f64]) -> Result<Vec<f64>, SimError>,
+) {
+    let (mut t0, mut q, mut v) = (0.0, q0.to_vec(), v0.to_vec());
+    for (k, &breakpoint) in breakpoints.iter().chain([&t_end]).enumerate() {
+        let last = k == breakpoints.len();
+        let segment_end = if last {
+            t_end
+        } else {
+            breakpoint - breakpoint_gap(breakpoint)
+        };
+        let st = match run_integrator(system, integrator, t0, &q, &v, segment_end, &mut *observer) {
+            Ok(st) => st,
+            Err(e) => {
+                summary.error = Some(e);
+                return;
+            }
+        };
+        summary.add_segment(&st);
+        if st.stopped_by_observer || last {
+            return;
+        }
+        q.copy_from_slice(st.q.as_slice());
+        t0 = breakpoint + breakpoint_gap(breakpoint);
+        match restart(system, st.t, t0, &q, st.v.as_slice()) {
+            Ok(vn) => v = vn,
+            Err(e) => {
+                summary.error = Some(e);
+                return;
+            }
+        }
+    }
+}
+
 /// The output grid of a run: rows at k·interval (and always at the end
 /// time), interpolated from the accepted steps by cubic Hermite
 /// interpolation, plus the progress callback now and then. Called once per
@@ -689,43 +757,16 @@ pub fn run_scenario(
         error: None,
         assessment: Vec::new(),
     };
-    let (mut t0, mut q, mut v) = (0.0, q0.clone(), v0.clone());
-    for (k, &breakpoint) in breakpoints.iter().chain([&t_end]).enumerate() {
-        let last = k == breakpoints.len();
-        let segment_end = if last {
-            t_end
-        } else {
-            breakpoint - breakpoint_gap(breakpoint)
-        };
-        let st = match run_integrator(
-            &mut system,
-            &scenario.integrator,
-            t0,
-            &q,
-            &v,
-            segment_end,
-            &mut observer,
-        ) {
-            Ok(st) => st,
-            Err(e) => {
-                summary.error = Some(e);
-                break;
-            }
-        };
-        summary.add_segment(&st);
-        if st.stopped_by_observer || last {
-            break;
-        }
-        q.copy_from_slice(st.q.as_slice());
-        t0 = breakpoint + breakpoint_gap(breakpoint);
-        match continuous_velocities(&mut system, st.t, t0, &q, st.v.as_slice()) {
-            Ok(vn) => v = vn,
-            Err(e) => {
-                summary.error = Some(e);
-                break;
-            }
-        }
-    }
+    integrate_segments(
+        &mut system,
+        &scenario.integrator,
+        (&q0, &v0),
+        &breakpoints,
+        t_end,
+        &mut observer,
+        &mut summary,
+        continuous_velocities,
+    );
 
     let cpu_time = start.elapsed().as_secs_f64();
     system.set_recorder(None);
@@ -737,15 +778,11 @@ pub fn run_scenario(
     if let Some(e) = rec.failure.take() {
         return Err(e);
     }
-    match &summary.error {
-        Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
-            summary.t_end = *t;
-        }
-        Some(_) => summary.t_end = schedule.last_time().unwrap_or(summary.t_end),
-        None => {}
-    }
-    summary.cpu_time = cpu_time;
-    summary.rows = rec.rows;
-    summary.assessment = system.assessment();
+    summary.finish(
+        cpu_time,
+        rec.rows,
+        schedule.last_time(),
+        system.assessment(),
+    );
     Ok(summary)
 }

@@ -24,8 +24,8 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, OutputSchedule, PendingRows, RunError, RunSummary, breakpoint_gap, columns,
-    continuous_velocities, drive_track_frames, run_integrator, scenario_state,
+    Columns, OutputSchedule, PendingRows, RunError, RunSummary, columns, continuous_velocities,
+    drive_track_frames, integrate_segments, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
@@ -699,58 +699,31 @@ pub fn run_train(
         error: None,
         assessment: Vec::new(),
     };
-    let (mut t0, mut q, mut v) = (0.0, q0.clone(), v0.clone());
-    for (k, &breakpoint) in breakpoints.iter().chain([&t_end]).enumerate() {
-        let last = k == breakpoints.len();
-        let segment_end = if last {
-            t_end
-        } else {
-            breakpoint - breakpoint_gap(breakpoint)
-        };
-        let st = match run_integrator(
-            &mut system,
-            &train.integrator,
-            t0,
-            &q,
-            &v,
-            segment_end,
-            &mut observer,
-        ) {
-            Ok(st) => st,
-            Err(e) => {
-                summary.error = Some(e);
-                break;
+    // Each vehicle keeps its bodies' absolute velocities across a kink.
+    integrate_segments(
+        &mut system,
+        &train.integrator,
+        (&q0, &v0),
+        &breakpoints,
+        t_end,
+        &mut observer,
+        &mut summary,
+        |system: &mut TrainSystem, t_prev, t0, q, v| {
+            let mut out = v.to_vec();
+            for kv in 0..system.vehicle_count() {
+                let r = system.range(kv);
+                let vn = continuous_velocities(
+                    system.vehicle_mut(kv),
+                    t_prev,
+                    t0,
+                    &q[r.clone()],
+                    &v[r.clone()],
+                )?;
+                out[r].copy_from_slice(&vn);
             }
-        };
-        summary.add_segment(&st);
-        if st.stopped_by_observer || last {
-            break;
-        }
-        q.copy_from_slice(st.q.as_slice());
-        t0 = breakpoint + breakpoint_gap(breakpoint);
-        // Each vehicle keeps its bodies' absolute velocities across the kink.
-        let mut failed = None;
-        for kv in 0..system.vehicle_count() {
-            let r = system.range(kv);
-            match continuous_velocities(
-                system.vehicle_mut(kv),
-                st.t,
-                t0,
-                &q[r.clone()],
-                &st.v.as_slice()[r.clone()],
-            ) {
-                Ok(vn) => v[r].copy_from_slice(&vn),
-                Err(e) => {
-                    failed = Some(e);
-                    break;
-                }
-            }
-        }
-        if let Some(e) = failed {
-            summary.error = Some(e);
-            break;
-        }
-    }
+            Ok(out)
+        },
+    );
 
     let cpu_time = start.elapsed().as_secs_f64();
     system.recorder = None;
@@ -762,15 +735,11 @@ pub fn run_train(
     if let Some(e) = rec.failure.take() {
         return Err(e);
     }
-    match &summary.error {
-        Some(SimError::NonFinite { t, .. }) | Some(SimError::Diverged { t, .. }) => {
-            summary.t_end = *t;
-        }
-        Some(_) => summary.t_end = schedule.last_time().unwrap_or(summary.t_end),
-        None => {}
-    }
-    summary.cpu_time = cpu_time;
-    summary.rows = rec.rows;
-    summary.assessment = system.assessment();
+    summary.finish(
+        cpu_time,
+        rec.rows,
+        schedule.last_time(),
+        system.assessment(),
+    );
     Ok(summary)
 }
