@@ -503,23 +503,36 @@ impl Recorder {
             self.values.push(s.s);
         }
         cols.values(system, t, q, v, &mut self.values, &mut self.force_values)?;
-        if let Some((path, w)) = self.writer.as_mut() {
-            use std::fmt::Write as _;
-            self.line.clear();
-            for (k, x) in self.values.iter().enumerate() {
-                if k > 0 {
-                    self.line.push(',');
-                }
-                let _ = write!(self.line, "{x}");
-            }
-            writeln!(w, "{}", self.line).map_err(|source| RunError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        }
+        write_row_text(&mut self.writer, &mut self.line, &self.values)?;
         self.rows += 1;
         Ok(())
     }
+}
+
+/// An open CSV output: its path (for errors) and the buffered file.
+pub(crate) type CsvWriter = Option<(PathBuf, std::io::BufWriter<std::fs::File>)>;
+
+/// Writes one CSV row of `values` (through the reusable `line` buffer).
+pub(crate) fn write_row_text(
+    writer: &mut CsvWriter,
+    line: &mut String,
+    values: &[f64],
+) -> Result<(), RunError> {
+    let Some((path, w)) = writer.as_mut() else {
+        return Ok(());
+    };
+    use std::fmt::Write as _;
+    line.clear();
+    for (k, x) in values.iter().enumerate() {
+        if k > 0 {
+            line.push(',');
+        }
+        let _ = write!(line, "{x}");
+    }
+    writeln!(w, "{line}").map_err(|source| RunError::Io {
+        path: path.clone(),
+        source,
+    })
 }
 
 /// Runs `scenario` on `model` with the engine `equations` and writes the output

@@ -25,7 +25,7 @@ use crate::forces::{
 use crate::model_system::ModelSystem;
 use crate::simulate::{
     Columns, OutputSchedule, PendingRows, RunError, RunSummary, columns, continuous_velocities,
-    drive_track_frames, integrate_segments, scenario_state,
+    drive_track_frames, integrate_segments, scenario_state, write_row_text,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
@@ -488,20 +488,7 @@ impl TrainRecorder {
             )?;
         }
         train.coupler_outputs(t, q, v, &mut self.values)?;
-        if let Some((path, w)) = self.writer.as_mut() {
-            use std::fmt::Write as _;
-            self.line.clear();
-            for (k, x) in self.values.iter().enumerate() {
-                if k > 0 {
-                    self.line.push(',');
-                }
-                let _ = write!(self.line, "{x}");
-            }
-            writeln!(w, "{}", self.line).map_err(|source| RunError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        }
+        write_row_text(&mut self.writer, &mut self.line, &self.values)?;
         self.rows += 1;
         Ok(())
     }

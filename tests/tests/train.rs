@@ -9,37 +9,6 @@ use railmbs_runtime::train::run_train;
 use railmbs_runtime::{Equations, MechanicalSystem, NumericEquations};
 use std::path::Path;
 
-/// Columns of a CSV output by name.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Table {
-    fn read(path: &Path) -> Table {
-        let text = std::fs::read_to_string(path).unwrap();
-        let mut lines = text.lines();
-        let header = lines
-            .next()
-            .unwrap()
-            .split(',')
-            .map(str::to_string)
-            .collect();
-        let rows = lines
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
-        Table { header, rows }
-    }
-    fn col(&self, name: &str) -> Vec<f64> {
-        let k = self
-            .header
-            .iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name}"));
-        self.rows.iter().map(|r| r[k]).collect()
-    }
-}
-
 /// A train file written to `dir` (paths in it are absolute).
 fn train_from_text(dir: &Path, text: &str) -> TrainScenario {
     let path = dir.join("train.ron");

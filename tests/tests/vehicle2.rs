@@ -8,37 +8,6 @@ use common::*;
 use railmbs_models::{Model, Scenario};
 use railmbs_runtime::{Equations, NumericEquations};
 
-/// Columns of a CSV output by name.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<f64>>,
-}
-
-impl Table {
-    fn read(path: &std::path::Path) -> Table {
-        let text = std::fs::read_to_string(path).unwrap();
-        let mut lines = text.lines();
-        let header = lines
-            .next()
-            .unwrap()
-            .split(',')
-            .map(str::to_string)
-            .collect();
-        let rows = lines
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
-        Table { header, rows }
-    }
-    fn col(&self, name: &str) -> Vec<f64> {
-        let k = self
-            .header
-            .iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name}"));
-        self.rows.iter().map(|r| r[k]).collect()
-    }
-}
-
 /// The bundled scenario shortened to `end_time`, and its model.
 fn scenario(end_time: f64) -> (Scenario, Model) {
     let mut scenario =

@@ -210,3 +210,39 @@ pub fn body_inertia(body: &railmbs_models::Body, params: &[f64]) -> nalgebra::Ma
     let i: Vec<f64> = body.inertia.iter().map(|x| x.eval(params, 0.0)).collect();
     nalgebra::Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2])
 }
+
+/// Columns of a CSV output of `umsim run` by name.
+pub struct Table {
+    /// Column names, `time` first.
+    pub header: Vec<String>,
+    /// One row of values per output time.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// Reads a CSV file written by a run (numbers only after the header).
+    pub fn read(path: &std::path::Path) -> Table {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        Table { header, rows }
+    }
+
+    /// The column `name`; panics naming it if absent.
+    pub fn col(&self, name: &str) -> Vec<f64> {
+        let k = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"));
+        self.rows.iter().map(|r| r[k]).collect()
+    }
+}
