@@ -263,6 +263,11 @@ pub struct Contact {
     /// Longitudinal lead per unit yaw (m/rad): the contact lies at `x_c = yaw_lead · ψ` ahead
     /// of the axle plane in the wheelset frame (small `ψ`).
     pub yaw_lead: f64,
+    /// Slope `dd/du` of the vertical distance along the wheel profile at this point (–): zero at
+    /// a true contact (a minimum of the distance), nonzero where a region's deepest point lies
+    /// on the region's boundary with the surface still falling into the next region
+    /// ([`ContactGeometry::region_contacts`]).
+    pub distance_slope: f64,
 }
 
 impl Contact {
@@ -693,6 +698,8 @@ impl ContactGeometry {
             wheel_transverse_curvature: -w.curvature(),
             rail_transverse_curvature: -r.curvature(),
             yaw_lead: s.sign * radius * delta.tan(),
+            // d = zz − h_r(v): dd/du = (sin φ + cos φ h_w') − h_r'(v)(cos φ − sin φ h_w').
+            distance_slope: (ss + cs * w.slope) - r.slope * (cs - ss * w.slope),
         }
     }
 
@@ -1220,7 +1227,7 @@ fn to_array(c: &Contact) -> [f64; 14] {
         c.wheel_transverse_curvature,
         c.rail_transverse_curvature,
         c.yaw_lead,
-        0.0,
+        c.distance_slope,
     ]
 }
 
@@ -1239,5 +1246,6 @@ fn from_array(a: [f64; 14]) -> Contact {
         wheel_transverse_curvature: a[10],
         rail_transverse_curvature: a[11],
         yaw_lead: a[12],
+        distance_slope: a[13],
     }
 }

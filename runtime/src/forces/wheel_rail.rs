@@ -64,6 +64,16 @@ pub const MIN_ROLLING_SPEED: f64 = 0.1;
 /// where Hertz's theory does not apply.
 const MIN_CURVATURE_RATIO: f64 = 1.0 / 25.0;
 
+/// Slope of the wheel–rail distance along the profile (–) at which a
+/// region's boundary point has lost its load entirely.
+const BOUNDARY_SLOPE: f64 = 0.05;
+
+/// 0 at 0, 1 from 1 on, C¹ between.
+fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
 /// Largest tan δ used for the contact's lead ahead of the axle plane (75°).
 const MAX_LEAD_TAN: f64 = 3.73;
 
@@ -385,14 +395,22 @@ impl WheelRailContact {
             let sign = if side == 0 { 1.0 } else { -1.0 };
             for c in sets[side] {
                 let penetration = -(c.gap + z_geom - dz);
-                if penetration <= 0.0 {
+                // A region's deepest point on the region boundary, where the
+                // surfaces still close towards the other region (distance
+                // slope ≠ 0), is not a contact of its own: the other region's
+                // slot holds it. Its load fades out with the slope; a true
+                // minimum born on the boundary has zero slope, so the load is
+                // continuous.
+                let weight = 1.0 - smoothstep(c.distance_slope.abs() / BOUNDARY_SLOPE);
+                if penetration <= 0.0 || weight == 0.0 {
                     continue;
                 }
                 let st = self.contact(
                     ctx,
                     b,
                     c,
-                    penetration,
+                    // N ∝ approach^{3/2}: the load scales by `weight`.
+                    penetration * weight.powf(2.0 / 3.0),
                     sign,
                     yaw,
                     rel.x,
