@@ -462,50 +462,108 @@ pub(crate) fn run_integrator<S: crate::system::MechanicalSystem>(
 /// outputs, so the file grows while the run goes on.
 pub(crate) struct Recorder {
     columns: Columns,
-    pending: PendingRows,
-    writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
-    rows: usize,
-    values: Vec<f64>,
-    /// All force elements' outputs of the row being written.
-    force_values: Vec<f64>,
-    line: String,
-    failure: Option<RunError>,
+    sink: CsvSink,
 }
 
 impl Recorder {
     /// Writes all pending rows. Needs the system for kinematics-based columns.
     pub(crate) fn flush(&mut self, system: &mut ModelSystem) {
+        let cols = &self.columns;
+        self.sink.drain(|values, force_values, t, q, v| {
+            if let Some(arc) = &cols.arc {
+                values.push(arc_position(arc, t)?);
+            }
+            cols.values(system, t, q, v, values, force_values)
+        });
+    }
+}
+
+/// Arc position s(t) of a speed law, m.
+pub(crate) fn arc_position(arc: &RunningSpeed, t: f64) -> Result<f64, RunError> {
+    use railmbs_track::SpeedLaw;
+    arc.motion(t)
+        .map(|m| m.s)
+        .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))
+}
+
+/// The CSV side of a run's output, shared by the scenario and train
+/// recorders: rows waiting to be written, the open file, reusable buffers,
+/// and the first write failure (after which rows are dropped).
+pub(crate) struct CsvSink {
+    pub(crate) pending: PendingRows,
+    writer: CsvWriter,
+    rows: usize,
+    values: Vec<f64>,
+    /// All force elements' outputs of the row being written.
+    force_values: Vec<f64>,
+    line: String,
+    pub(crate) failure: Option<RunError>,
+}
+
+impl CsvSink {
+    /// Creates `output` (and its folder) with the header line; no file for
+    /// `None` (rows are still counted).
+    pub(crate) fn open(output: Option<&Path>, header: &[String]) -> Result<Self, RunError> {
+        let writer = match output {
+            Some(p) => {
+                if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir).map_err(|source| RunError::Io {
+                        path: dir.to_path_buf(),
+                        source,
+                    })?;
+                }
+                let io = |source| RunError::Io {
+                    path: p.to_path_buf(),
+                    source,
+                };
+                let mut w = std::io::BufWriter::new(std::fs::File::create(p).map_err(io)?);
+                writeln!(w, "{}", header.join(",")).map_err(io)?;
+                Some((p.to_path_buf(), w))
+            }
+            None => None,
+        };
+        Ok(Self {
+            pending: Default::default(),
+            writer,
+            rows: 0,
+            values: Vec::new(),
+            force_values: Vec::new(),
+            line: String::new(),
+            failure: None,
+        })
+    }
+
+    /// Writes the pending rows: each starts with its time, `fill` appends the
+    /// rest (given the row and a buffer for force outputs). The first failure
+    /// is kept and stops the writing.
+    pub(crate) fn drain(
+        &mut self,
+        mut fill: impl FnMut(&mut Vec<f64>, &mut Vec<f64>, f64, &[f64], &[f64]) -> Result<(), RunError>,
+    ) {
         while let Some((t, q, v)) = self.pending.pop_front() {
             if self.failure.is_some() {
                 continue;
             }
-            if let Err(e) = self.write_row(system, t, &q, &v) {
-                self.failure = Some(e);
+            self.values.clear();
+            self.values.push(t);
+            let written = fill(&mut self.values, &mut self.force_values, t, &q, &v)
+                .and_then(|()| write_row_text(&mut self.writer, &mut self.line, &self.values));
+            match written {
+                Ok(()) => self.rows += 1,
+                Err(e) => self.failure = Some(e),
             }
         }
     }
 
-    fn write_row(
-        &mut self,
-        system: &mut ModelSystem,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-    ) -> Result<(), RunError> {
-        let cols = &self.columns;
-        self.values.clear();
-        self.values.push(t);
-        if let Some(arc) = &cols.arc {
-            use railmbs_track::SpeedLaw;
-            let s = arc
-                .motion(t)
-                .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))?;
-            self.values.push(s.s);
+    /// Flushes the file; returns the rows written, or the first failure.
+    pub(crate) fn close(&mut self) -> Result<usize, RunError> {
+        if let Some((path, mut w)) = self.writer.take() {
+            w.flush().map_err(|source| RunError::Io { path, source })?;
         }
-        cols.values(system, t, q, v, &mut self.values, &mut self.force_values)?;
-        write_row_text(&mut self.writer, &mut self.line, &self.values)?;
-        self.rows += 1;
-        Ok(())
+        match self.failure.take() {
+            Some(e) => Err(e),
+            None => Ok(self.rows),
+        }
     }
 }
 
@@ -711,36 +769,9 @@ pub fn run_scenario(
     }
     let arc = binding.as_ref().map(|b| b.speed.clone());
     let columns = columns(model, &system, &scenario.output, &scenario.source, arc)?;
-    let writer = match output {
-        Some(p) => {
-            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir).map_err(|source| RunError::Io {
-                    path: dir.to_path_buf(),
-                    source,
-                })?;
-            }
-            let f = std::fs::File::create(p).map_err(|source| RunError::Io {
-                path: p.to_path_buf(),
-                source,
-            })?;
-            let mut w = std::io::BufWriter::new(f);
-            writeln!(w, "{}", columns.header.join(",")).map_err(|source| RunError::Io {
-                path: p.to_path_buf(),
-                source,
-            })?;
-            Some((p.to_path_buf(), w))
-        }
-        None => None,
-    };
     let recorder = std::rc::Rc::new(std::cell::RefCell::new(Recorder {
+        sink: CsvSink::open(output, &columns.header)?,
         columns,
-        pending: Default::default(),
-        writer,
-        rows: 0,
-        values: Vec::new(),
-        force_values: Vec::new(),
-        line: String::new(),
-        failure: None,
     }));
     system.set_recorder(Some(recorder.clone()));
 
@@ -749,10 +780,10 @@ pub fn run_scenario(
     let start = Instant::now();
     let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
         let mut rec = recorder.borrow_mut();
-        if rec.failure.is_some() {
+        if rec.sink.failure.is_some() {
             return ControlFlow::Break(());
         }
-        schedule.observe(t, q, v, a, &mut rec.pending, &mut progress);
+        schedule.observe(t, q, v, a, &mut rec.sink.pending, &mut progress);
         ControlFlow::Continue(())
     };
     // Integrate from breakpoint to breakpoint (kinks of the track), restarting
@@ -785,17 +816,7 @@ pub fn run_scenario(
     system.set_recorder(None);
     let mut rec = recorder.borrow_mut();
     rec.flush(&mut system);
-    if let Some((path, mut w)) = rec.writer.take() {
-        w.flush().map_err(|source| RunError::Io { path, source })?;
-    }
-    if let Some(e) = rec.failure.take() {
-        return Err(e);
-    }
-    summary.finish(
-        cpu_time,
-        rec.rows,
-        schedule.last_time(),
-        system.assessment(),
-    );
+    let rows = rec.sink.close()?;
+    summary.finish(cpu_time, rows, schedule.last_time(), system.assessment());
     Ok(summary)
 }

@@ -24,17 +24,16 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, OutputSchedule, PendingRows, RunError, RunSummary, columns, continuous_velocities,
-    drive_track_frames, integrate_segments, scenario_state, write_row_text,
+    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, columns,
+    continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model, TrainCoupler, TrainScenario};
 use std::cell::RefCell;
-use std::io::Write;
 use std::ops::{ControlFlow, Range};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::rc::Rc;
 use std::time::Instant;
 
@@ -439,58 +438,29 @@ struct TrainRecorder {
     /// belongs to (the column `s[m]` is the train's reference arc position).
     arc: Option<(RunningSpeed, f64)>,
     columns: Vec<Columns>,
-    pending: PendingRows,
-    writer: Option<(PathBuf, std::io::BufWriter<std::fs::File>)>,
-    rows: usize,
-    values: Vec<f64>,
-    force_values: Vec<f64>,
-    line: String,
-    failure: Option<RunError>,
+    sink: CsvSink,
 }
 
 impl TrainRecorder {
     fn flush(&mut self, train: &mut TrainSystem) {
-        while let Some((t, q, v)) = self.pending.pop_front() {
-            if self.failure.is_some() {
-                continue;
+        let (arc, columns) = (&self.arc, &self.columns);
+        self.sink.drain(|values, force_values, t, q, v| {
+            if let Some((arc, offset)) = arc {
+                values.push(arc_position(arc, t)? - offset);
             }
-            if let Err(e) = self.write_row(train, t, &q, &v) {
-                self.failure = Some(e);
+            for (k, cols) in columns.iter().enumerate() {
+                let r = train.range(k);
+                cols.values(
+                    train.vehicle_mut(k),
+                    t,
+                    &q[r.clone()],
+                    &v[r],
+                    values,
+                    force_values,
+                )?;
             }
-        }
-    }
-
-    fn write_row(
-        &mut self,
-        train: &mut TrainSystem,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-    ) -> Result<(), RunError> {
-        self.values.clear();
-        self.values.push(t);
-        if let Some((arc, offset)) = &self.arc {
-            use railmbs_track::SpeedLaw;
-            let s = arc
-                .motion(t)
-                .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))?;
-            self.values.push(s.s - offset);
-        }
-        for (k, cols) in self.columns.iter().enumerate() {
-            let r = train.range(k);
-            cols.values(
-                train.vehicle_mut(k),
-                t,
-                &q[r.clone()],
-                &v[r],
-                &mut self.values,
-                &mut self.force_values,
-            )?;
-        }
-        train.coupler_outputs(t, q, v, &mut self.values)?;
-        write_row_text(&mut self.writer, &mut self.line, &self.values)?;
-        self.rows += 1;
-        Ok(())
+            Ok(train.coupler_outputs(t, q, v, values)?)
+        });
     }
 }
 
@@ -628,37 +598,10 @@ pub fn run_train(
         columns,
         arc,
     } = build_train(train, models, engines)?;
-    let writer = match output {
-        Some(p) => {
-            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir).map_err(|source| RunError::Io {
-                    path: dir.to_path_buf(),
-                    source,
-                })?;
-            }
-            let f = std::fs::File::create(p).map_err(|source| RunError::Io {
-                path: p.to_path_buf(),
-                source,
-            })?;
-            let mut w = std::io::BufWriter::new(f);
-            writeln!(w, "{}", header.join(",")).map_err(|source| RunError::Io {
-                path: p.to_path_buf(),
-                source,
-            })?;
-            Some((p.to_path_buf(), w))
-        }
-        None => None,
-    };
     let recorder = Rc::new(RefCell::new(TrainRecorder {
+        sink: CsvSink::open(output, &header)?,
         arc,
         columns,
-        pending: Default::default(),
-        writer,
-        rows: 0,
-        values: Vec::new(),
-        force_values: Vec::new(),
-        line: String::new(),
-        failure: None,
     }));
     system.recorder = Some(recorder.clone());
 
@@ -667,10 +610,10 @@ pub fn run_train(
     let start = Instant::now();
     let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
         let mut rec = recorder.borrow_mut();
-        if rec.failure.is_some() {
+        if rec.sink.failure.is_some() {
             return ControlFlow::Break(());
         }
-        schedule.observe(t, q, v, a, &mut rec.pending, &mut progress);
+        schedule.observe(t, q, v, a, &mut rec.sink.pending, &mut progress);
         ControlFlow::Continue(())
     };
     let mut summary = RunSummary {
@@ -716,17 +659,7 @@ pub fn run_train(
     system.recorder = None;
     let mut rec = recorder.borrow_mut();
     rec.flush(&mut system);
-    if let Some((path, mut w)) = rec.writer.take() {
-        w.flush().map_err(|source| RunError::Io { path, source })?;
-    }
-    if let Some(e) = rec.failure.take() {
-        return Err(e);
-    }
-    summary.finish(
-        cpu_time,
-        rec.rows,
-        schedule.last_time(),
-        system.assessment(),
-    );
+    let rows = rec.sink.close()?;
+    summary.finish(cpu_time, rows, schedule.last_time(), system.assessment());
     Ok(summary)
 }
