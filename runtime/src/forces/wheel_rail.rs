@@ -38,6 +38,7 @@
 use super::{
     ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment, eval_scalar,
 };
+use crate::equations::BodyKinematics;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{Matrix3, Vector3};
@@ -188,6 +189,11 @@ pub struct WheelRailContact {
     bound: Option<Bound>,
     /// Running maxima over accepted steps, for the assessment summary.
     maxima: Maxima,
+    /// The last solved state and what it was solved for (time and the
+    /// wheelset's kinematics): the accept-step hook, the outputs and the
+    /// Jacobian usually ask again for the state the last force evaluation
+    /// saw, and the contact solution is the costly part of a step.
+    last: std::sync::Mutex<Option<(f64, BodyKinematics, WheelsetState)>>,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -222,6 +228,7 @@ impl WheelRailContact {
             c: Constants::default(),
             bound: None,
             maxima: Maxima::default(),
+            last: std::sync::Mutex::new(None),
         }
     }
 
@@ -317,8 +324,26 @@ impl WheelRailContact {
         Ok(prepared)
     }
 
-    /// Solves both wheels' contacts at the context's state.
+    /// [`Self::solve_new`], or the stored result for the same time and
+    /// wheelset kinematics.
     fn solve(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+        let body = ctx.bodies[self.spec.wheelset];
+        if let Ok(last) = self.last.lock()
+            && let Some((t, k, state)) = last.as_ref()
+            && *t == ctx.t
+            && *k == body
+        {
+            return Ok(*state);
+        }
+        let state = self.solve_new(ctx)?;
+        if let Ok(mut last) = self.last.lock() {
+            *last = Some((ctx.t, body, state));
+        }
+        Ok(state)
+    }
+
+    /// Solves both wheels' contacts at the context's state.
+    fn solve_new(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
         let Some(b) = &self.bound else {
             return Err(self.err(
                 "no track: a wheel–rail element needs the scenario's track (`track: (file: …)`)",
