@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use railmbs_models::{Model, Scenario};
-use railmbs_runtime::{Equations, NumericEquations};
+use railmbs_runtime::NumericEquations;
 
 /// The bundled scenario shortened to `end_time`, and its model.
 fn scenario(end_time: f64) -> (Scenario, Model) {
@@ -15,17 +15,6 @@ fn scenario(end_time: f64) -> (Scenario, Model) {
     scenario.end_time = end_time;
     let model = railmbs_models::load_model(&scenario.model).unwrap();
     (scenario, model)
-}
-
-fn run(scenario: &Scenario, model: &Model, engine: Box<dyn Equations>) -> Table {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out.csv");
-    let summary =
-        railmbs_runtime::simulate::run_scenario(scenario, model, engine, Some(&out), |_| {})
-            .unwrap();
-    assert!(summary.error.is_none(), "{:?}", summary.error);
-    assert!((summary.t_end - scenario.end_time).abs() < 1e-9);
-    Table::read(&out)
 }
 
 fn param(model: &Model, name: &str) -> f64 {
@@ -63,15 +52,15 @@ fn assert_static(model: &Model, t: &Table) {
 #[test]
 fn vehicle2_starts_with_a_quarter_of_its_weight_on_every_wheel() {
     let (scenario, model) = scenario(0.5);
-    let t = run(&scenario, &model, Box::new(NumericEquations::new(&model)));
+    let t = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
     assert_static(&model, &t);
 }
 
 #[test]
 fn vehicle2_runs_with_the_symbolic_engine_as_with_the_numeric() {
     let (scenario, model) = scenario(0.5);
-    let a = run(&scenario, &model, Box::new(NumericEquations::new(&model)));
-    let b = run(&scenario, &model, Box::new(symbolic_engine(&model)));
+    let a = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
+    let b = run_to_table(&scenario, &model, Box::new(symbolic_engine(&model)));
     assert_static(&model, &b);
     // Same start, same equations: the car body's height agrees to far below
     // the 4e-4 m static sinking of the wheels.

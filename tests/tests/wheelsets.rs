@@ -12,18 +12,7 @@ use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
 fn run(scenario: &str) -> Table {
     let scenario = railmbs_models::load_scenario(&model_path(scenario)).unwrap();
     let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out.csv");
-    let summary = railmbs_runtime::simulate::run_scenario(
-        &scenario,
-        &model,
-        Box::new(NumericEquations::new(&model)),
-        Some(&out),
-        |_| {},
-    )
-    .unwrap();
-    assert!(summary.error.is_none(), "{:?}", summary.error);
-    Table::read(&out)
+    run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)))
 }
 
 /// Times where `y` crosses zero upwards (linear interpolation).
@@ -105,18 +94,7 @@ fn vehicle1_in_the_1200_m_curve(speed: f64) -> (f64, f64, f64) {
     scenario.end_time = (800.0 - track.start) / speed + 0.1;
     scenario.output.interval = 0.05;
     let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out.csv");
-    let summary = railmbs_runtime::simulate::run_scenario(
-        &scenario,
-        &model,
-        Box::new(NumericEquations::new(&model)),
-        Some(&out),
-        |_| {},
-    )
-    .unwrap();
-    assert!(summary.error.is_none(), "{:?}", summary.error);
-    let t = Table::read(&out);
+    let t = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
     let s = t.col("s[m]");
     let sum = |name: &str| -> Vec<f64> {
         let mut acc = vec![0.0; s.len()];
@@ -214,18 +192,7 @@ fn vehicle1_on_perfect_straight_track_stays_centred() {
     scenario.end_time = 3.0;
     scenario.output.coordinates = true;
     let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out.csv");
-    let summary = railmbs_runtime::simulate::run_scenario(
-        &scenario,
-        &model,
-        Box::new(NumericEquations::new(&model)),
-        Some(&out),
-        |_| {},
-    )
-    .unwrap();
-    assert!(summary.error.is_none(), "{:?}", summary.error);
-    let t = Table::read(&out);
+    let t = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
     let mut worst: f64 = 0.0;
     for c in model
         .coordinates

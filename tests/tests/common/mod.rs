@@ -246,3 +246,21 @@ impl Table {
         self.rows.iter().map(|r| r[k]).collect()
     }
 }
+
+/// Runs `scenario` on `model` with `engine`, writing the CSV to a temporary
+/// folder; asserts the run reached its end time without error and returns
+/// the output.
+pub fn run_to_table(
+    scenario: &railmbs_models::Scenario,
+    model: &Model,
+    engine: Box<dyn Equations>,
+) -> Table {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let summary =
+        railmbs_runtime::simulate::run_scenario(scenario, model, engine, Some(&out), |_| {})
+            .unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    assert!((summary.t_end - scenario.end_time).abs() < 1e-9);
+    Table::read(&out)
+}
