@@ -44,7 +44,7 @@ fn bench(c: &mut Criterion) {
             k = k.wrapping_add(1);
             let y = ((k % 2000) as f64 - 1000.0) * 1.3e-5;
             let roll = ((k % 37) as f64 - 18.0) * 1e-3;
-            black_box(table.lookup(black_box(y), black_box(roll)).unwrap())
+            black_box(table.lookup_regions(black_box(y), black_box(roll)).unwrap())
         })
     });
     c.bench_function("direct_contact_search", |b| {

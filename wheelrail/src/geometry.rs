@@ -872,7 +872,6 @@ pub struct ContactTable {
     dy: f64,
     r0: f64,
     dr: f64,
-    nodes: Vec<[ContactSet; 2]>,
     rigid: Vec<RigidContact>,
     /// Per side, the wheel profile coordinate `u` (m) that separates the
     /// tread and flange regions of [`ContactTable::lookup_regions`].
@@ -890,9 +889,6 @@ pub struct ContactTable {
     /// Wheel radius R per side, m.
     radius: [f64; 2],
 }
-
-/// Contacts further apart than this on the wheel (m) are not interpolated with each other.
-const MATCH_DISTANCE: f64 = 3e-3;
 
 impl ContactTable {
     /// Computes the tables for `wheelset` on `track`.
@@ -921,14 +917,6 @@ impl ContactTable {
         let nr = 2 * (settings.roll_max / settings.droll).round() as usize + 1;
         let y0 = -(((ny - 1) / 2) as f64) * settings.dy;
         let r0 = -(((nr - 1) / 2) as f64) * settings.droll;
-        let mut nodes = Vec::with_capacity(ny * nr);
-        for i in 0..ny {
-            let y = y0 + i as f64 * settings.dy;
-            for j in 0..nr {
-                let roll = r0 + j as f64 * settings.droll;
-                nodes.push(geo.contacts(y, roll)?);
-            }
-        }
         // rigid functions from the centre outwards (continuation of the roll guess)
         let mut rigid = vec![None; ny];
         let ic = (ny - 1) / 2;
@@ -968,7 +956,6 @@ impl ContactTable {
             dy: settings.dy,
             r0,
             dr: settings.droll,
-            nodes,
             rigid,
             split,
             regions,
@@ -1017,10 +1004,6 @@ impl ContactTable {
         Ok((i, (t - i as f64).clamp(0.0, 1.0)))
     }
 
-    /// Contacts of the left and right wheel for lateral shift `y` (m) and roll `roll` (rad),
-    /// bilinearly interpolated. The contact count follows the nearest node; each contact is
-    /// interpolated with the matching contacts (nearest on the wheel) of the surrounding nodes,
-    /// so that the tread-to-flange jump is not smeared.
     /// The wheel profile coordinates `u` (m; left, right wheel) that separate
     /// the tread and flange regions of [`ContactTable::lookup_regions`]: the
     /// middle of the jump of the rigid wheelset's contact point (by more than
@@ -1034,10 +1017,13 @@ impl ContactTable {
     /// The deepest point of the tread and of the flange region of each wheel
     /// ([`ContactGeometry::region_contacts`]) at lateral shift `y` (m) and
     /// roll `roll` (rad), wheelset height z = 0: `[side][slot]`, slot 0 the
-    /// tread side. Bilinear interpolation of every quantity between the four
-    /// surrounding nodes, with the gap's rigid-body dependence on roll removed
-    /// before and restored after, so the result is continuous in y and roll —
-    /// what a time integration needs. Both slots are always returned; a slot
+    /// tread side. The gap is interpolated cubically along the wheel's own
+    /// lateral shift w and linearly in roll, and the contact angle is the one
+    /// of the gap's lateral slope, `tan δ = −∂gap/∂y` — the profiles' contact
+    /// angle where the contact point moves smoothly, and continuous (the
+    /// gradient of the gap) where it jumps; the other quantities are
+    /// bilinear. So the result is continuous in y and roll — what a time
+    /// integration needs. Both slots are always returned; a slot
     /// with a positive gap is not in contact. Near the flange root of
     /// profiles whose contact point jumps, both slots may touch at once: the
     /// load is then shared by two patches where in reality one conformal
@@ -1120,73 +1106,6 @@ impl ContactTable {
                 // inclined by δ closes the gap by tan δ per metre).
                 c.contact_angle = (-slope).atan();
                 out[side][slot] = c;
-            }
-        }
-        Ok(out)
-    }
-
-    pub fn lookup(&self, y: f64, roll: f64) -> Result<[ContactSet; 2], GeometryError> {
-        let (i, ty) = Self::locate("lateral shift", y, self.y0, self.dy, self.ny)?;
-        let (j, tr) = Self::locate("roll", roll, self.r0, self.dr, self.nr)?;
-        let j1 = (j + 1).min(self.nr - 1);
-        let i1 = (i + 1).min(self.ny - 1);
-        let corners = [
-            (i, j, (1.0 - ty) * (1.0 - tr)),
-            (i1, j, ty * (1.0 - tr)),
-            (i, j1, (1.0 - ty) * tr),
-            (i1, j1, ty * tr),
-        ];
-        let near = corners
-            .iter()
-            .max_by(|a, b| a.2.total_cmp(&b.2))
-            .expect("four corners");
-        let mut out = [ContactSet::default(); 2];
-        let sign = [1.0, -1.0];
-        for (side, o) in out.iter_mut().enumerate() {
-            let base = &self.nodes[near.0 * self.nr + near.1][side];
-            o.count = base.count;
-            for slot in 0..base.count {
-                let c0 = &base.contacts[slot];
-                let mut acc = [0.0; 14];
-                let mut wsum = 0.0;
-                for &(ci, cj, w) in &corners {
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let node_roll = sign[side] * (self.r0 + cj as f64 * self.dr);
-                    let set = &self.nodes[ci * self.nr + cj][side];
-                    let m = set
-                        .as_slice()
-                        .iter()
-                        .min_by(|a, b| {
-                            (a.wheel_u - c0.wheel_u)
-                                .abs()
-                                .total_cmp(&(b.wheel_u - c0.wheel_u).abs())
-                        })
-                        .expect("at least one contact");
-                    if (m.wheel_u - c0.wheel_u).abs() > MATCH_DISTANCE {
-                        continue;
-                    }
-                    // The gap's rigid-body dependence on roll, sin φ·ξ + (cos φ − 1)·ζ for the
-                    // wheel point (ξ, ζ) in side-local wheelset coordinates, is removed before
-                    // interpolating and restored at the requested roll, so that the gap stays
-                    // accurate where a corner lacks the matching contact.
-                    let mut v = to_array(m);
-                    let (xi, zeta) = (sign[side] * m.wheel_y, m.wheel_z);
-                    v[0] -= node_roll.sin() * xi + (node_roll.cos() - 1.0) * zeta;
-                    for (a, v) in acc.iter_mut().zip(v) {
-                        *a += w * v;
-                    }
-                    wsum += w;
-                }
-                o.contacts[slot] = if wsum > 0.0 {
-                    let mut c = from_array(acc.map(|a| a / wsum));
-                    let q = sign[side] * roll;
-                    c.gap += q.sin() * sign[side] * c.wheel_y + (q.cos() - 1.0) * c.wheel_z;
-                    c
-                } else {
-                    *c0
-                };
             }
         }
         Ok(out)

@@ -236,12 +236,21 @@ fn table_lookup_matches_direct_search() {
     let t = std::time::Instant::now();
     let table = ContactTable::from_geometry(&geo, settings).unwrap();
     println!("small table: {:?}", t.elapsed());
-    // at nodes: identical to the direct search
-    let at = table.lookup(1.2e-3, 1e-3).unwrap();
-    let d = geo.contacts(1.2e-3, 1e-3).unwrap();
+    // The deepest of a wheel's two region slots is the direct search's contact.
+    let deepest = |slots: &[Contact; 2]| {
+        if slots[1].gap < slots[0].gap {
+            slots[1]
+        } else {
+            slots[0]
+        }
+    };
+    // At nodes (roll 0: the table's w grid is the y grid): identical.
+    let at = table.lookup_regions(1.2e-3, 0.0).unwrap();
+    let d = geo.contacts(1.2e-3, 0.0).unwrap();
     for s in 0..2 {
-        assert_eq!(at[s].count, d[s].count);
-        assert!((at[s].contacts[0].rolling_radius - d[s].contacts[0].rolling_radius).abs() < 1e-12);
+        let (ca, cb) = (deepest(&at[s]), d[s].deepest());
+        assert!((ca.gap - cb.gap).abs() < 1e-12);
+        assert!((ca.rolling_radius - cb.rolling_radius).abs() < 1e-12);
     }
     // between nodes on the S1002 tread, rolling radius and gap interpolate to 20 µm (the contact
     // moves continuously except where it jumps; compare where no jump occurs)
@@ -249,10 +258,10 @@ fn table_lookup_matches_direct_search() {
     for k in 0..40 {
         let y = -3.9e-3 + k as f64 * 0.195e-3;
         let roll = -3.5e-3 + k as f64 * 0.17e-3;
-        let a = table.lookup(y, roll).unwrap();
+        let a = table.lookup_regions(y, roll).unwrap();
         let b = geo.contacts(y, roll).unwrap();
         for s in 0..2 {
-            let (ca, cb) = (a[s].deepest(), b[s].deepest());
+            let (ca, cb) = (deepest(&a[s]), b[s].deepest());
             if (ca.wheel_u - cb.wheel_u).abs() < 1e-3 {
                 compared += 1;
                 assert!((ca.rolling_radius - cb.rolling_radius).abs() < 20e-6);
@@ -265,10 +274,12 @@ fn table_lookup_matches_direct_search() {
     let rf = table.rigid_functions();
     assert_eq!(rf.len(), 81);
     assert!(rf[40].y.abs() < 1e-15 && rf[40].rolling_radius_difference().abs() < 1e-12);
-    // outside the table: a clear error
-    let e = table.lookup(0.005, 0.0).unwrap_err();
+    // outside the table (lateral range plus R sin(roll_max) = 5.84 mm): a clear error
+    let e = table.lookup_regions(0.007, 0.0).unwrap_err();
     assert!(matches!(e, GeometryError::OutOfRange { .. }), "{e}");
-    assert!(table.lookup(0.0, f64::NAN).is_err());
+    let e = table.lookup_regions(0.0, 0.005).unwrap_err();
+    assert!(matches!(e, GeometryError::OutOfRange { .. }), "{e}");
+    assert!(table.lookup_regions(0.0, f64::NAN).is_err());
 }
 
 #[test]
