@@ -131,7 +131,7 @@ fn vehicle1_in_the_1200_m_curve(speed: f64) -> (f64, f64, f64) {
 /// wheelsets run up to 3 mm towards the outer rail, where S1002 on UIC60
 /// 1:40 moves the contact points asymmetrically (0.757 m and −0.740 m from
 /// the track centre instead of ±0.753 m), so each wheelset's moment balance
-/// puts about 3 % more load on the outer wheel; the simulation gives 3.5 %.
+/// puts about 3 % more load on the outer wheel; the simulation gives 4.3 %.
 #[test]
 fn vehicle1_at_the_balancing_speed_loads_both_rails_equally() {
     let (g, radius, cant, e2): (f64, f64, f64, f64) = (9.81, 1200.0, 0.150, 1.5);

@@ -650,13 +650,16 @@ impl ForceElement for WheelRailContact {
                  use `rail: Rigid`",
             ));
         }
-        let rebind = self.bound.is_some() && (c.radius != self.c.radius);
-        self.c = c;
-        if rebind {
+        // The contact table is built from these when the track is bound.
+        let geometry = |c: &Constants| (c.radius, c.flange_back_distance, c.taping_offset);
+        if self.bound.is_some() && geometry(&c) != geometry(&self.c) {
             return Err(self.err(
-                "changing the wheel radius after the track is bound needs a new contact table",
+                "the wheel radius, back-to-back distance and taping line are fixed once the \
+                 contact table is built (at the start of the run)",
             ));
         }
+        self.c = c;
+        *self.last.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
         Ok(())
     }
 
@@ -741,7 +744,9 @@ impl ForceElement for WheelRailContact {
 
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let Ok(state) = self.solve(ctx) else {
-            out.extend(std::iter::repeat_n(f64::NAN, 28));
+            // Only at an interpolated output state the steps never visited
+            // (the step states themselves were solved): NaN marks the gap.
+            out.extend(std::iter::repeat_n(f64::NAN, self.output_names().len()));
             return;
         };
         let loads = Self::wheel_loads(&state);
