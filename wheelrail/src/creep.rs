@@ -14,13 +14,17 @@
 //! - [`Mueller`]: the linear force saturated towards `μN`;
 //! - [`Fastsim`]: Kalker's FASTSIM algorithm (simplified theory);
 //! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (seed paper Sect. 4.3):
-//!   closed-form strips, cost proportional to the number of strips only.
+//!   closed-form strips, cost proportional to the number of strips only;
+//! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
+//!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
 
 mod fastsim;
 mod fastsim_a;
+mod polach;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::FastsimA;
+pub use polach::Polach;
 
 pub use crate::creepage::Creepages;
 use crate::kalker::KalkerCoefficients;
@@ -73,7 +77,7 @@ pub enum CreepError {
 
 /// A creep-force law.
 pub trait CreepLaw {
-    /// Short name (`kalker`, `mueller`, `fastsim`, `fastsim-a`).
+    /// Short name (`kalker`, `mueller`, `fastsim`, `fastsim-a`, `polach`).
     fn name(&self) -> &'static str;
     /// Forces on the wheel for the given patch and creepages; validates inputs.
     fn forces(&self, patch: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError>;
