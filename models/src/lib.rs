@@ -115,6 +115,11 @@
 //! // beyond the end rows; deflection m increasing, force N) plus d·ẋ. A bump stop:
 //! Tabulated(name: "stop", body1: "a", body2: "b", table: [(-0.02, -2e4), (-0.01, 0), (0.01, 0), (0.02, 2e4)],
 //!           d: 100, x0: 0.5),
+//! // Stiffness c in series with damping d (a Maxwell element), preload f0 in
+//! // parallel: F = c·s + f0 with d·(ẋ − ṡ) = c·s. The spring extension s is a
+//! // first-order state `<name>.s` integrated with q (Park's method only; RK4
+//! // refuses the model); it starts relaxed, s = 0.
+//! SeriesSpring(name: "yaw_damper", body1: "a", body2: "b", c: 5e6, d: 2e5, f0: 0, x0: 0.5),
 //! ```
 //!
 //! As for `Spring`, x is the distance of the two points and a positive force

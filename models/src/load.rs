@@ -1669,6 +1669,34 @@ impl Cx<'_> {
                         free_length: self.expr(&w, "x0", "x0", x0, false),
                     }
                 }
+                RawForce::SeriesSpring {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                    c,
+                    d,
+                    f0,
+                    x0,
+                    ..
+                } => {
+                    let stiffness = self.expr(&w, "c", "c", c, false);
+                    let damping = self.expr(&w, "d", "d", d, false);
+                    self.check_positive(&w, "c", &stiffness);
+                    self.check_positive(&w, "d", &damping);
+                    let (body1, point1, body2, point2) =
+                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
+                    ForceKind::SeriesSpringDamper {
+                        body1,
+                        point1,
+                        body2,
+                        point2,
+                        stiffness,
+                        damping,
+                        preload: self.expr(&w, "f0", "f0", f0, false),
+                        free_length: self.expr(&w, "x0", "x0", x0, false),
+                    }
+                }
                 RawForce::Linear6 {
                     body1,
                     point1,

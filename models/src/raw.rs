@@ -457,6 +457,21 @@ pub(crate) enum RawForce {
         #[serde(default)]
         x0: Value,
     },
+    SeriesSpring {
+        name: String,
+        body1: String,
+        #[serde(default = "zero3")]
+        point1: Vec3,
+        body2: String,
+        #[serde(default = "zero3")]
+        point2: Vec3,
+        c: Value,
+        d: Value,
+        #[serde(default)]
+        f0: Value,
+        #[serde(default)]
+        x0: Value,
+    },
     Linear6 {
         name: String,
         body1: String,
@@ -595,6 +610,7 @@ impl RawForce {
             | RawForce::Applied { name, .. }
             | RawForce::PointPlane { name, .. }
             | RawForce::Coulomb { name, .. }
+            | RawForce::SeriesSpring { name, .. }
             | RawForce::LoadFriction { name, .. }
             | RawForce::Tabulated { name, .. }
             | RawForce::WheelRail { name, .. } => name,

@@ -44,6 +44,15 @@ impl ForceKind {
                 preload,
                 free_length,
                 ..
+            }
+            | ForceKind::SeriesSpringDamper {
+                point1,
+                point2,
+                stiffness,
+                damping,
+                preload,
+                free_length,
+                ..
             } => {
                 point1.iter_mut().chain(point2.iter_mut()).for_each(&mut *f);
                 for e in [stiffness, damping, preload, free_length] {
@@ -194,6 +203,7 @@ impl ForceKind {
     pub fn bodies_mut(&mut self, f: &mut dyn FnMut(&mut usize)) {
         match self {
             ForceKind::Bipolar { body1, body2, .. }
+            | ForceKind::SeriesSpringDamper { body1, body2, .. }
             | ForceKind::Linear6 { body1, body2, .. }
             | ForceKind::Coulomb { body1, body2, .. }
             | ForceKind::LoadFriction { body1, body2, .. }

@@ -24,6 +24,14 @@ pub struct ModelSystem {
     recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
     /// Zeros, the velocity argument of constraint evaluations.
     zero_velocity: Vec<f64>,
+    /// The engine's generalized coordinates n; the force elements' first-order
+    /// states follow them in the system's q (see [`ForceElement::state_count`]).
+    n_coordinates: usize,
+    /// Element states z and rates ż at the last evaluation.
+    states: Vec<f64>,
+    state_rates: Vec<f64>,
+    /// Per element with states: (element index, offset into z, count).
+    state_owners: Vec<(usize, usize, usize)>,
 }
 
 impl std::fmt::Debug for ModelSystem {
@@ -67,8 +75,16 @@ impl ModelSystem {
         }
         equations.set_parameters(&params)?;
         let mut forces = forces::build(model);
-        for f in &mut forces {
+        let mut state_owners = Vec::new();
+        let mut n_states = 0;
+        for (i, f) in forces.iter_mut().enumerate() {
             f.set_parameters(&params)?;
+            let count = f.state_count();
+            if count > 0 {
+                f.set_state_offset(n_states);
+                state_owners.push((i, n_states, count));
+                n_states += count;
+            }
         }
         let eval = Evaluation::for_equations(equations.as_ref());
         let nb = equations.body_count();
@@ -92,6 +108,10 @@ impl ModelSystem {
             forces_initialized: false,
             recorder: None,
             zero_velocity: Vec::new(),
+            n_coordinates: model.coordinates.len(),
+            states: vec![0.0; n_states],
+            state_rates: vec![0.0; n_states],
+            state_owners,
         })
     }
 
@@ -146,7 +166,81 @@ impl ModelSystem {
         &self.params
     }
 
-    /// Evaluates `parts` at a state and returns the buffers (for outputs and tests).
+    /// Number of the engine's generalized coordinates (the system's q and q̇
+    /// also carry the force elements' first-order states after them).
+    pub fn coordinate_count(&self) -> usize {
+        self.n_coordinates
+    }
+
+    /// Number of first-order element states.
+    pub fn state_count(&self) -> usize {
+        self.states.len()
+    }
+
+    /// Long names of the first-order element states (`<element>.<state>`), in
+    /// the order they follow the coordinates.
+    pub fn state_names(&self) -> Vec<String> {
+        self.state_owners
+            .iter()
+            .flat_map(|&(i, _, _)| {
+                let f = &self.forces[i];
+                f.state_names()
+                    .into_iter()
+                    .map(move |s| format!("{}.{s}", f.name()))
+            })
+            .collect()
+    }
+
+    /// The system's initial q and q̇ from the coordinates' (`q`, `v`, n
+    /// entries each): appends the element states and rates consistent with
+    /// their equations at (t, q, v).
+    pub fn initial_state(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), SimError> {
+        let (mut qs, mut vs) = (q.to_vec(), v.to_vec());
+        if self.state_owners.is_empty() {
+            return Ok((qs, vs));
+        }
+        self.equations
+            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)?;
+        let n = self.states.len();
+        let (mut z, mut zdot) = (vec![0.0; n], vec![0.0; n]);
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
+        };
+        for &(i, offset, count) in &self.state_owners {
+            self.forces[i].initial_states(
+                &ctx,
+                &mut z[offset..offset + count],
+                &mut zdot[offset..offset + count],
+            );
+        }
+        qs.extend(z);
+        vs.extend(zdot);
+        Ok((qs, vs))
+    }
+
+    /// Splits the system's q, q̇ into the coordinates' part (returned) and the
+    /// element states (stored for the force elements).
+    fn take_states<'q>(&mut self, q: &'q [f64], v: &'q [f64]) -> (&'q [f64], &'q [f64]) {
+        let n = self.n_coordinates;
+        if q.len() > n {
+            self.states.copy_from_slice(&q[n..]);
+            self.state_rates.copy_from_slice(&v[n..]);
+        }
+        (&q[..n.min(q.len())], &v[..n.min(v.len())])
+    }
+
+    /// Evaluates `parts` at a state and returns the buffers (for outputs and
+    /// tests). `q`, `v` are the system's (coordinates, then element states) or
+    /// the coordinates only.
     pub fn evaluate(
         &mut self,
         t: f64,
@@ -154,6 +248,7 @@ impl ModelSystem {
         v: &[f64],
         parts: Parts,
     ) -> Result<&Evaluation, SimError> {
+        let (q, v) = self.take_states(q, v);
         self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
         Ok(&self.eval)
     }
@@ -165,6 +260,8 @@ impl ModelSystem {
             t,
             bodies: &self.eval.bodies,
             params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
         };
         for f in &self.forces {
             f.outputs(&ctx, out);
@@ -172,9 +269,11 @@ impl ModelSystem {
     }
 
     /// Generalized applied forces Q = Q_g + Σ_j Γ_jᵀ F_j (needs kinematics and
-    /// Jacobians evaluated).
+    /// Jacobians evaluated) in the coordinates' rows of `out`, and the element
+    /// state residuals in the rows after them.
     fn applied_forces(&mut self, t: f64, out: &mut DVector<f64>) -> Result<(), SimError> {
-        out.copy_from(&self.eval.gravity);
+        let n = self.n_coordinates;
+        out.rows_mut(0, n).copy_from(&self.eval.gravity);
         if self.forces.is_empty() {
             return Ok(());
         }
@@ -183,9 +282,15 @@ impl ModelSystem {
             t,
             bodies: &self.eval.bodies,
             params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
         };
         for f in &self.forces {
             f.apply(&ctx, &mut self.wrenches)?;
+        }
+        for &(i, offset, count) in &self.state_owners {
+            let rows = &mut out.as_mut_slice()[n + offset..n + offset + count];
+            self.forces[i].state_residuals(&ctx, rows);
         }
         let jac = &self.eval.jacobians;
         for (j, w) in self.wrenches.iter().enumerate() {
@@ -195,7 +300,7 @@ impl ModelSystem {
             if comps.iter().all(|c| *c == 0.0) {
                 continue;
             }
-            for (i, qi) in out.iter_mut().enumerate() {
+            for (i, qi) in out.iter_mut().take(n).enumerate() {
                 let mut s = 0.0;
                 for (k, c) in comps.iter().enumerate() {
                     s += jac[(6 * j + k, i)] * c;
@@ -209,7 +314,7 @@ impl ModelSystem {
 
 impl MechanicalSystem for ModelSystem {
     fn dof(&self) -> usize {
-        self.equations.dof()
+        self.n_coordinates + self.states.len()
     }
 
     fn n_constraints(&self) -> usize {
@@ -230,11 +335,20 @@ impl MechanicalSystem for ModelSystem {
         if !self.forces_initialized {
             self.accept_forces(t, q, v);
         }
+        let (q, v) = self.take_states(q, v);
         self.equations
             .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
         self.applied_forces(t, force)?;
-        *force -= &self.eval.bias;
-        mass.copy_from(&self.eval.mass);
+        let n = self.n_coordinates;
+        let mut top = force.rows_mut(0, n);
+        top -= &self.eval.bias;
+        if self.states.is_empty() {
+            mass.copy_from(&self.eval.mass);
+        } else {
+            // Element states have no inertia: zero rows and columns.
+            mass.fill(0.0);
+            mass.view_mut((0, 0), (n, n)).copy_from(&self.eval.mass);
+        }
         Ok(())
     }
 
@@ -246,6 +360,7 @@ impl MechanicalSystem for ModelSystem {
         jacobian: &mut DMatrix<f64>,
     ) -> Result<(), SimError> {
         // Constraints depend on q only; reuse a zero velocity vector.
+        let q = &q[..self.n_coordinates];
         self.zero_velocity.resize(q.len(), 0.0);
         let parts = Parts {
             mass: false,
@@ -258,7 +373,15 @@ impl MechanicalSystem for ModelSystem {
         self.equations
             .evaluate(t, q, &self.zero_velocity, parts, &mut self.eval)?;
         g.copy_from(&self.eval.constraints);
-        jacobian.copy_from(&self.eval.constraint_jacobian);
+        if self.states.is_empty() {
+            jacobian.copy_from(&self.eval.constraint_jacobian);
+        } else {
+            jacobian.fill(0.0);
+            let (nc, n) = self.eval.constraint_jacobian.shape();
+            jacobian
+                .view_mut((0, 0), (nc, n))
+                .copy_from(&self.eval.constraint_jacobian);
+        }
         Ok(())
     }
 
@@ -287,6 +410,7 @@ impl MechanicalSystem for ModelSystem {
             jacobians: true,
             constraints: false,
         };
+        let (q, v) = self.take_states(q, v);
         self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
         dfdq.fill(0.0);
         dfdv.fill(0.0);
@@ -294,6 +418,8 @@ impl MechanicalSystem for ModelSystem {
             t,
             bodies: &self.eval.bodies,
             params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
         };
         let mut jac = ForceJacobian::new(
             &self.eval.jacobians,
@@ -323,6 +449,7 @@ impl ModelSystem {
         if self.forces.is_empty() {
             return;
         }
+        let (q, v) = self.take_states(q, v);
         if self
             .equations
             .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)
@@ -334,6 +461,8 @@ impl ModelSystem {
             t,
             bodies: &self.eval.bodies,
             params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
         };
         for f in &mut self.forces {
             f.accept_step(&ctx);

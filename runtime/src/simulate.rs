@@ -177,9 +177,11 @@ pub(crate) fn columns(
     }
     if spec.coordinates {
         header.extend(model.coordinates.iter().map(|c| c.name.clone()));
+        header.extend(system.state_names());
     }
     if spec.velocities {
         header.extend(model.coordinates.iter().map(|c| format!("{}.v", c.name)));
+        header.extend(system.state_names().iter().map(|c| format!("{c}.v")));
     }
     let body_names: Vec<String> = model.bodies.iter().map(|b| b.name.clone()).collect();
     let bodies = select(&body_names, &spec.bodies, "body", file)?;
@@ -396,7 +398,9 @@ pub(crate) fn continuous_velocities(
         .svd(true, true)
         .solve(&rhs, 1e-12)
         .map_err(|e| SimError::Other(format!("velocity re-initialization at t = {t} s: {e}")))?;
-    Ok(solution.iter().copied().collect())
+    // Element states keep their rates (their equations hold at the next step).
+    let n = solution.len();
+    Ok(solution.iter().chain(&v[n..]).copied().collect())
 }
 
 /// Time, coordinates, velocities and accelerations at the end of a step.
@@ -415,6 +419,19 @@ pub(crate) fn hermite(t0: f64, t1: f64, t: f64, y0: f64, d0: f64, y1: f64, d1: f
         + (s3 - 2.0 * s2 + s) * h * d0
         + (-2.0 * s3 + 3.0 * s2) * y1
         + (s3 - s2) * h * d1
+}
+
+/// Refuses an explicit integrator for a system with first-order element
+/// states (their rows of the mass matrix are zero).
+pub(crate) fn check_integrator(system: &ModelSystem, spec: &IntegratorSpec) -> Result<(), String> {
+    if matches!(spec, IntegratorSpec::Rk4 { .. }) && system.state_count() > 0 {
+        return Err(format!(
+            "the model has first-order element states ({}) which the explicit RK4 integrator \
+             cannot solve; use `integrator: Park(..)`",
+            system.state_names().join(", ")
+        ));
+    }
+    Ok(())
 }
 
 /// Integrator settings of a scenario.
@@ -752,6 +769,11 @@ pub fn run_scenario(
     let (equations, breakpoints, binding) =
         drive_track_frames(scenario, model, &params, equations)?;
     let mut system = ModelSystem::new(model, equations, params)?;
+    check_integrator(&system, &scenario.integrator).map_err(|message| RunError::Setup {
+        file: scenario.source.clone(),
+        message,
+    })?;
+    let (q0, v0) = system.initial_state(0.0, &q0, &v0)?;
     match &binding {
         Some(b) => system.bind_track(b)?,
         None => {

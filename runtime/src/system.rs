@@ -36,8 +36,14 @@ pub trait MechanicalSystem {
         0
     }
 
-    /// Mass matrix M (n×n, symmetric positive definite) and f = Q − k (n).
-    /// `mass` and `force` come sized; implementations overwrite them.
+    /// Mass matrix M (n×n, symmetric) and f = Q − k (n). `mass` and `force`
+    /// come sized; implementations overwrite them.
+    ///
+    /// M is positive definite except for rows that are entirely zero: those
+    /// carry first-order state variables z (a spring in series with a damper)
+    /// whose equations r(q, q̇, z, ż) = 0 are the corresponding rows of f.
+    /// Park's method solves them with the equations of motion; explicit
+    /// integrators refuse such systems.
     fn dynamics(
         &mut self,
         t: f64,

@@ -24,8 +24,8 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, columns,
-    continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
+    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, check_integrator,
+    columns, continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
@@ -257,6 +257,8 @@ impl TrainSystem {
                 t,
                 bodies: &bodies,
                 params: &[],
+                states: &[],
+                state_rates: &[],
             };
             self.couplers[ci].element.outputs(&ctx, out);
         }
@@ -301,6 +303,8 @@ impl MechanicalSystem for TrainSystem {
                 t,
                 bodies: &bodies,
                 params: &[],
+                states: &[],
+                state_rates: &[],
             };
             let mut w = [Wrench::default(); 2];
             c.element.apply(&ctx, &mut w)?;
@@ -396,6 +400,8 @@ impl MechanicalSystem for TrainSystem {
                 t,
                 bodies: &bodies,
                 params: &[],
+                states: &[],
+                state_rates: &[],
             };
             let mut jac = ForceJacobian::new(&gamma, &bodies, &mut dq, &mut dv, &mut self.scratch);
             c.element.add_jacobian(&ctx, &mut jac)?;
@@ -536,8 +542,11 @@ pub fn build_train(
         let cols = columns(model, &system, &scenario.output, &train.source, None)?;
         header.extend(cols.header.iter().skip(1).map(|h| format!("{name}.{h}")));
         columns_all.push(cols);
-        q0.extend(state.q);
-        v0.extend(state.v);
+        check_integrator(&system, &train.integrator)
+            .map_err(|m| setup(format!("vehicle \"{name}\": {m}")))?;
+        let (q, v) = system.initial_state(0.0, &state.q, &state.v)?;
+        q0.extend(q);
+        v0.extend(v);
         breakpoints.extend(times);
         vehicles.push((name.clone(), system));
     }

@@ -369,6 +369,12 @@ pub(super) fn force_value_problems(kind: &ForceKind, d: &[f64]) -> Vec<String> {
     };
     match kind {
         ForceKind::Bipolar { .. } | ForceKind::Linear6 { .. } | ForceKind::Applied { .. } => {}
+        ForceKind::SeriesSpringDamper {
+            stiffness, damping, ..
+        } => {
+            positive(&mut out, "c", stiffness);
+            positive(&mut out, "d", damping);
+        }
         ForceKind::PointPlane {
             normal,
             stiffness,

@@ -33,6 +33,11 @@ impl TwoPoint {
         }
     }
 
+    /// The two attachment points.
+    pub fn ends(&self) -> &[Attachment; 2] {
+        &self.ends
+    }
+
     pub fn set_parameters(&mut self, params: &[f64], owner: &str) -> Result<(), SimError> {
         for e in &mut self.ends {
             e.set_parameters(params, owner)?;

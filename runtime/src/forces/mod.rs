@@ -10,6 +10,7 @@ mod bipolar;
 pub mod contact;
 mod linear6;
 pub mod nonlinear;
+mod series;
 pub mod wheel_rail;
 
 pub use applied::AppliedForce;
@@ -17,6 +18,7 @@ pub use bipolar::LinearBipolar;
 pub use contact::{PointPlane, contact_stiffness_damping};
 pub use linear6::Linear6;
 pub use nonlinear::{CoulombFriction, LoadFriction, Tabulated};
+pub use series::SeriesSpringDamper;
 pub use wheel_rail::{TrackBinding, WheelRailContact};
 
 use crate::equations::BodyKinematics;
@@ -54,13 +56,19 @@ pub struct Assessment {
     pub unit: &'static str,
 }
 
-/// What a force element sees: time, body kinematics (model order), parameters.
+/// What a force element sees: time, body kinematics (model order), parameters,
+/// and the first-order state variables of all elements with their rates.
 #[derive(Debug, Clone, Copy)]
 pub struct ForceContext<'a> {
     /// s.
     pub t: f64,
     pub bodies: &'a [BodyKinematics],
     pub params: &'a [f64],
+    /// First-order element states z of the whole system (see
+    /// [`ForceElement::state_count`]); each element reads its own slice.
+    pub states: &'a [f64],
+    /// Their rates ż, same layout.
+    pub state_rates: &'a [f64],
 }
 
 /// A force element of the runtime.
@@ -94,6 +102,29 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn assessment(&self) -> Vec<Assessment> {
         Vec::new()
     }
+    /// Number of first-order state variables the element adds to the system
+    /// (a spring in series with a damper: its spring extension). They are
+    /// appended to the generalized coordinates with zero mass-matrix rows; the
+    /// element's state equations r(q, q̇, z, ż) = 0 take those rows of the
+    /// force vector, so an implicit integrator solves them together with the
+    /// equations of motion (Park's method treats them with the same
+    /// derivative formula as q).
+    fn state_count(&self) -> usize {
+        0
+    }
+    /// Names of the states (without the element's name), units in brackets.
+    fn state_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Tells the element where its states start in [`ForceContext::states`].
+    fn set_state_offset(&mut self, _offset: usize) {}
+    /// Initial states and rates consistent with the state equations at the
+    /// initial kinematics, written to the element's own slices (`z`, `zdot`
+    /// have `state_count` entries).
+    fn initial_states(&self, _ctx: &ForceContext, _z: &mut [f64], _zdot: &mut [f64]) {}
+    /// Residuals of the element's state equations (in force units, so that
+    /// the rows scale like the equations of motion), `state_count` entries.
+    fn state_residuals(&self, _ctx: &ForceContext, _out: &mut [f64]) {}
     /// Adds the element's approximate contribution to ∂Q/∂q and ∂Q/∂q̇ (paper
     /// Sect. 6, Eq. 31): its local stiffness and damping matrices mapped by the
     /// Jacobians of its attachment points, neglecting the derivatives of the
@@ -336,6 +367,40 @@ impl<'a> ForceJacobian<'a> {
         self.project(12, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
     }
 
+    /// The coupling of an element's first-order state with index `k` in the
+    /// full coordinate vector to the relative position d = P₂ − P₁ of two
+    /// points, with G = Γ_P₂ − Γ_P₁ (3 × n): adds Gᵀ`dq_column` to column k of
+    /// `dq` (the force f₂ on P₂ depends on the state: `dq_column` = ∂f₂/∂z),
+    /// `dq_row`ᵀG to row k of `dq` and `dv_row`ᵀG to row k of `dv` (the state
+    /// residual depends on d and ḋ: `dq_row` = ∂r/∂d, `dv_row` = ∂r/∂ḋ).
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_pair_state(
+        &mut self,
+        body1: Option<usize>,
+        p1: &Vector3<f64>,
+        body2: Option<usize>,
+        p2: &Vector3<f64>,
+        k: usize,
+        dq_column: &Vector3<f64>,
+        dq_row: &Vector3<f64>,
+        dv_row: &Vector3<f64>,
+    ) {
+        if body1.is_none() && body2.is_none() {
+            return;
+        }
+        self.begin(body1, body2, 3);
+        self.point_rows(0, body2, p2, 1.0);
+        self.point_rows(0, body1, p1, -1.0);
+        let s = &*self.scratch;
+        let m = s.cols.len();
+        for (ci, &i) in s.cols.iter().enumerate() {
+            let g = |u: &Vector3<f64>| (0..3).map(|r| u[r] * s.h[r * m + ci]).sum::<f64>();
+            self.dq[(i, k)] += g(dq_column);
+            self.dq[(k, i)] += g(dq_row);
+            self.dv[(k, i)] += g(dv_row);
+        }
+    }
+
     /// Position of body `b`'s centre of mass (SC0), m.
     pub fn body_position(&self, b: usize) -> Vector3<f64> {
         self.bodies[b].position
@@ -405,6 +470,9 @@ pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
             let name = f.name.clone();
             match &f.kind {
                 ForceKind::Bipolar { .. } => Box::new(LinearBipolar::new(name, &f.kind)),
+                ForceKind::SeriesSpringDamper { .. } => {
+                    Box::new(SeriesSpringDamper::new(name, &f.kind))
+                }
                 ForceKind::Linear6 { .. } => Box::new(Linear6::new(name, &f.kind)),
                 ForceKind::Applied { .. } => Box::new(AppliedForce::new(name, &f.kind)),
                 ForceKind::PointPlane { .. } => Box::new(PointPlane::new(name, &f.kind)),

@@ -300,6 +300,12 @@ struct Work {
     lu: DenseLu,
     /// LU workspace of the acceleration-level (KKT) system.
     lu_kkt: DenseLu,
+    /// Rows of M that are entirely zero (first-order states).
+    massless: Vec<usize>,
+    /// Per coordinate: a first-order state (zero row of M). Its "velocity" is
+    /// the derivative the formula computes, not a state of its own, and stays
+    /// out of the error test: the Newton error δz would show in it as δz/β.
+    first_order: Vec<bool>,
     gamma: DVector<f64>,
     gp: DVector<f64>,
     rhs: DVector<f64>,
@@ -349,6 +355,8 @@ impl Work {
             constrained: vec![false; n],
             lu: DenseLu::new(n + nc),
             lu_kkt: DenseLu::new(n + nc),
+            massless: Vec::new(),
+            first_order: vec![false; n],
             gamma: DVector::zeros(nc),
             gp: DVector::zeros(nc),
             rhs: DVector::zeros(n + nc),
@@ -448,6 +456,18 @@ impl Work {
                 m[(i, j)] = self.mass[(i, j)];
             }
         }
+        // Rows without inertia (first-order element states, see
+        // `MechanicalSystem::dynamics`): their second derivative does not enter
+        // the equations; take it as zero.
+        self.massless.clear();
+        for i in 0..n {
+            let none = (0..n).all(|j| self.mass[(i, j)] == 0.0);
+            self.first_order[i] = none;
+            if none {
+                self.massless.push(i);
+                m[(i, i)] = 1.0;
+            }
+        }
         for k in 0..nc {
             for j in 0..n {
                 let gkj = self.gjac[(k, j)];
@@ -467,6 +487,9 @@ impl Work {
             });
         }
         self.rhs.rows_mut(0, n).copy_from(&self.force);
+        for &i in &self.massless {
+            self.rhs[i] = 0.0;
+        }
         for k in 0..nc {
             self.rhs[n + k] = -self.gamma[k];
         }
@@ -901,6 +924,10 @@ impl Work {
         for i in 0..self.n {
             let wq = atol + rtol * self.hq[0][i].abs().max(self.q[i].abs());
             let eq = ratio * (self.q[i] - self.qp[i]) / wq;
+            if self.first_order[i] {
+                sum += eq * eq;
+                continue;
+            }
             let mut wv = atol + rtol * self.hv[0][i].abs().max(self.v[i].abs());
             if self.constrained[i] {
                 wv /= hs;
