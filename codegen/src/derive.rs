@@ -200,6 +200,9 @@ pub fn expr_to_cas(ctx: &mut Context, e: &Expr, opts: &DeriveOptions) -> ExprId 
             }
         }
         Expr::Time => ctx.sym(Symbol::t()),
+        // Local variables exist only in force-element fields evaluated by the
+        // runtime (the loader refuses them elsewhere); never in kinematics.
+        Expr::Var(_) => ctx.num(f64::NAN),
         Expr::Neg(a) => {
             let a = expr_to_cas(ctx, a, opts);
             ctx.neg(a)

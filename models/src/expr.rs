@@ -16,11 +16,15 @@ pub enum Func {
 
 /// An expression tree. `Param(i)` is the identifier `Model::parameters[i]`,
 /// which stays a runtime input of both engines; `Time` is `t` in seconds.
+/// `Var(i)` is a local variable bound by the force element that evaluates the
+/// expression ([`VAR_NAMES`]`[i]`: the coordinates `x`, `y` of a point–Z-surface
+/// contact's height `z = f(x, y)`); only such element fields accept them.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {
     Num(f64),
     Param(usize),
     Time,
+    Var(usize),
     Neg(Box<Expr>),
     Add(Box<Expr>, Box<Expr>),
     Sub(Box<Expr>, Box<Expr>),
@@ -30,6 +34,9 @@ pub enum Expr {
     Pow(Box<Expr>, Box<Expr>),
     Call(Func, Box<Expr>),
 }
+
+/// Names of the local variables `Var(0)`, `Var(1)` in expression text.
+pub const VAR_NAMES: [&str; 2] = ["x", "y"];
 
 impl Func {
     /// All functions, for iteration.
@@ -86,7 +93,7 @@ fn precedence(e: &Expr) -> u8 {
         Expr::Neg(..) => 3,
         Expr::Pow(..) => 4,
         // A negative literal is displayed in parentheses, so it is atomic too.
-        Expr::Num(_) | Expr::Param(_) | Expr::Time | Expr::Call(..) => 5,
+        Expr::Num(_) | Expr::Param(_) | Expr::Time | Expr::Var(_) | Expr::Call(..) => 5,
     }
 }
 
@@ -110,31 +117,59 @@ impl Expr {
     /// `Model::parameters`) at time `t` (s). A parameter index outside `params`
     /// evaluates to NaN (callers validate indices when the model is loaded).
     pub fn eval(&self, params: &[f64], t: f64) -> f64 {
+        self.eval_vars(params, t, &[])
+    }
+
+    /// Evaluates the expression with the local variables `vars` (`Var(i)` is
+    /// `vars[i]`; a missing one is NaN).
+    pub fn eval_vars(&self, params: &[f64], t: f64, vars: &[f64]) -> f64 {
+        let e = |x: &Expr| x.eval_vars(params, t, vars);
         match self {
             Expr::Num(x) => *x,
             Expr::Param(i) => params.get(*i).copied().unwrap_or(f64::NAN),
             Expr::Time => t,
-            Expr::Neg(a) => -a.eval(params, t),
-            Expr::Add(a, b) => a.eval(params, t) + b.eval(params, t),
-            Expr::Sub(a, b) => a.eval(params, t) - b.eval(params, t),
-            Expr::Mul(a, b) => a.eval(params, t) * b.eval(params, t),
-            Expr::Div(a, b) => a.eval(params, t) / b.eval(params, t),
-            Expr::Pow(a, b) => pow(a.eval(params, t), b.eval(params, t)),
-            Expr::Call(f, a) => f.apply(a.eval(params, t)),
+            Expr::Var(i) => vars.get(*i).copied().unwrap_or(f64::NAN),
+            Expr::Neg(a) => -e(a),
+            Expr::Add(a, b) => e(a) + e(b),
+            Expr::Sub(a, b) => e(a) - e(b),
+            Expr::Mul(a, b) => e(a) * e(b),
+            Expr::Div(a, b) => e(a) / e(b),
+            Expr::Pow(a, b) => pow(e(a), e(b)),
+            Expr::Call(f, a) => f.apply(e(a)),
         }
     }
 
     /// True if the expression depends on time `t`.
     pub fn has_time(&self) -> bool {
+        self.depends_on(&Expr::Time)
+    }
+
+    /// True if the expression contains the leaf `leaf` (`Time`, a `Param` or
+    /// a `Var`).
+    fn depends_on(&self, leaf: &Expr) -> bool {
         match self {
-            Expr::Num(_) | Expr::Param(_) => false,
-            Expr::Time => true,
-            Expr::Neg(a) | Expr::Call(_, a) => a.has_time(),
+            Expr::Num(_) => false,
+            Expr::Param(_) | Expr::Time | Expr::Var(_) => self == leaf,
+            Expr::Neg(a) | Expr::Call(_, a) => a.depends_on(leaf),
             Expr::Add(a, b)
             | Expr::Sub(a, b)
             | Expr::Mul(a, b)
             | Expr::Div(a, b)
-            | Expr::Pow(a, b) => a.has_time() || b.has_time(),
+            | Expr::Pow(a, b) => a.depends_on(leaf) || b.depends_on(leaf),
+        }
+    }
+
+    /// True if the expression uses a local variable (`Var`).
+    pub fn has_vars(&self) -> bool {
+        match self {
+            Expr::Num(_) | Expr::Param(_) | Expr::Time => false,
+            Expr::Var(_) => true,
+            Expr::Neg(a) | Expr::Call(_, a) => a.has_vars(),
+            Expr::Add(a, b)
+            | Expr::Sub(a, b)
+            | Expr::Mul(a, b)
+            | Expr::Div(a, b)
+            | Expr::Pow(a, b) => a.has_vars() || b.has_vars(),
         }
     }
 
@@ -149,7 +184,7 @@ impl Expr {
 
     fn collect_params(&self, out: &mut Vec<usize>) {
         match self {
-            Expr::Num(_) | Expr::Time => {}
+            Expr::Num(_) | Expr::Time | Expr::Var(_) => {}
             Expr::Param(i) => out.push(*i),
             Expr::Neg(a) | Expr::Call(_, a) => a.collect_params(out),
             Expr::Add(a, b)
@@ -167,7 +202,7 @@ impl Expr {
     pub fn map_params(&self, f: &mut impl FnMut(usize) -> Expr) -> Expr {
         let bx = |e: Expr| Box::new(e);
         match self {
-            Expr::Num(_) | Expr::Time => self.clone(),
+            Expr::Num(_) | Expr::Time | Expr::Var(_) => self.clone(),
             Expr::Param(i) => f(*i),
             Expr::Neg(a) => Expr::Neg(bx(a.map_params(f))),
             Expr::Call(g, a) => Expr::Call(*g, bx(a.map_params(f))),
@@ -186,30 +221,41 @@ impl Expr {
     /// Where the derivative is undefined (`abs` at 0, `sqrt` at 0) it evaluates
     /// to NaN or ±∞ there, as the mathematics says.
     pub fn time_derivative(&self) -> Expr {
-        if !self.has_time() {
+        self.derivative(&Expr::Time)
+    }
+
+    /// The partial derivative with respect to the local variable `Var(i)`
+    /// (parameters, time and other variables held constant), simplified as
+    /// [`Expr::time_derivative`].
+    pub fn var_derivative(&self, i: usize) -> Expr {
+        self.derivative(&Expr::Var(i))
+    }
+
+    /// The partial derivative with respect to the leaf `wrt`.
+    fn derivative(&self, wrt: &Expr) -> Expr {
+        if !self.depends_on(wrt) {
             return Expr::Num(0.0);
         }
         match self {
-            Expr::Num(_) | Expr::Param(_) => Expr::Num(0.0),
-            Expr::Time => Expr::Num(1.0),
-            Expr::Neg(a) => neg(a.time_derivative()),
-            Expr::Add(a, b) => add(a.time_derivative(), b.time_derivative()),
-            Expr::Sub(a, b) => sub(a.time_derivative(), b.time_derivative()),
+            Expr::Num(_) | Expr::Param(_) | Expr::Time | Expr::Var(_) => Expr::Num(1.0),
+            Expr::Neg(a) => neg(a.derivative(wrt)),
+            Expr::Add(a, b) => add(a.derivative(wrt), b.derivative(wrt)),
+            Expr::Sub(a, b) => sub(a.derivative(wrt), b.derivative(wrt)),
             // (ab)' = a'b + ab'
             Expr::Mul(a, b) => add(
-                mul(a.time_derivative(), (**b).clone()),
-                mul((**a).clone(), b.time_derivative()),
+                mul(a.derivative(wrt), (**b).clone()),
+                mul((**a).clone(), b.derivative(wrt)),
             ),
             // (a/b)' = a'/b − a b'/b²
             Expr::Div(a, b) => sub(
-                div(a.time_derivative(), (**b).clone()),
+                div(a.derivative(wrt), (**b).clone()),
                 div(
-                    mul((**a).clone(), b.time_derivative()),
+                    mul((**a).clone(), b.derivative(wrt)),
                     mul((**b).clone(), (**b).clone()),
                 ),
             ),
             Expr::Pow(a, b) => {
-                if !b.has_time() {
+                if !b.depends_on(wrt) {
                     // (a^b)' = b a^(b−1) a'
                     let exponent = match **b {
                         Expr::Num(n) => Expr::Num(n - 1.0),
@@ -222,20 +268,20 @@ impl Expr {
                     } else {
                         Expr::Pow(a.clone(), Box::new(exponent))
                     };
-                    mul(mul((**b).clone(), power), a.time_derivative())
+                    mul(mul((**b).clone(), power), a.derivative(wrt))
                 } else {
                     // (a^b)' = a^b (b' ln a + b a'/a)
                     mul(
                         self.clone(),
                         add(
-                            mul(b.time_derivative(), call(Func::Ln, (**a).clone())),
-                            div(mul((**b).clone(), a.time_derivative()), (**a).clone()),
+                            mul(b.derivative(wrt), call(Func::Ln, (**a).clone())),
+                            div(mul((**b).clone(), a.derivative(wrt)), (**a).clone()),
                         ),
                     )
                 }
             }
             Expr::Call(f, a) => {
-                let da = a.time_derivative();
+                let da = a.derivative(wrt);
                 let x = (**a).clone();
                 let outer = match f {
                     Func::Sin => call(Func::Cos, x),
@@ -294,6 +340,12 @@ impl Expr {
                 }
             },
             Expr::Time => out.push('t'),
+            Expr::Var(i) => match VAR_NAMES.get(*i) {
+                Some(n) => out.push_str(n),
+                None => {
+                    let _ = write!(out, "var{i}");
+                }
+            },
             Expr::Neg(a) => {
                 out.push('-');
                 a.write_operand(names, 4, out);

@@ -103,6 +103,11 @@
 //! PointPlane(name: "feet", body: "block", points: [(0.1, 0.1, -0.05), (-0.1, 0.1, -0.05)],
 //!            plane_body: "ground", origin: (0, 0, 0), normal: (0, 0, 1),   // defaults
 //!            c: 1e6, d: 500, ct: 1e6, dt: 500, mu0: 0.3, mu: 0.25),      // mu0 default mu
+//! // Point–Z-surface variant: the surface z = f(x, y) (an expression in x, y —
+//! // m, in the plane body's frame shifted to `origin` — and parameters), solid
+//! // below; each point touches its tangent plane there (normal (−f_x, −f_y, 1)).
+//! PointPlane(name: "bowl", body: "ball", points: [(0, 0, -0.05)], surface: "(x^2 + y^2)/(2*2.5)",
+//!            c: 1e6, d: 500, mu: 0.1),
 //! // Bipolar Coulomb friction: sticking F = f0 + c (x − x0) + d ẋ (f0, x0 stored
 //! // when sticking starts) until |F| reaches `limit` (F0); then sliding at
 //! // `sliding` (default `limit`) against the relative velocity.
@@ -293,9 +298,9 @@ pub mod scenario;
 mod visit;
 
 pub use error::{ModelError, ModelErrors};
-pub use expr::{Expr, Func};
+pub use expr::{Expr, Func, VAR_NAMES};
 pub use load::{load_model, parse_model};
 pub use model::*;
-pub use parser::{ParseError, ParseErrorKind, parse_expr, parse_expr_with};
+pub use parser::{ParseError, ParseErrorKind, parse_expr, parse_expr_vars, parse_expr_with};
 pub use scenario::*;
 pub use scenario::{load_scenario, parse_scenario};

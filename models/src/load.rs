@@ -1,10 +1,10 @@
 //! Loading a model file: RON → raw syntax → resolved, validated [`Model`].
 
 use crate::error::{ModelError, ModelErrors};
-use crate::expr::Expr;
+use crate::expr::{Expr, VAR_NAMES};
 use crate::locate::{Locator, Span};
 use crate::model::*;
-use crate::parser::{ParseErrorKind, is_identifier, is_reserved_name, parse_expr};
+use crate::parser::{ParseErrorKind, is_identifier, is_reserved_name, parse_expr, parse_expr_vars};
 use crate::raw::*;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -217,6 +217,47 @@ impl Cx<'_> {
     }
 
     /// Resolves a numeric field. `label` names it in messages, `key` is its RON key.
+    /// The height z = f(x, y) of a point–Z-surface contact: an expression in
+    /// the local variables x, y and the parameters, finite with the default
+    /// parameters at x = y = 0.
+    fn surface_expr(&mut self, w: &Where, v: &Value) -> Expr {
+        let s = match v {
+            Value::Num(x) => return self.expr(w, "surface", "surface", &Value::Num(*x), false),
+            Value::Text(s) => s,
+        };
+        let names = &self.names;
+        match parse_expr_vars(s, false, &VAR_NAMES, |id| names.iter().position(|n| n == id)) {
+            Ok(e) => {
+                if let Some(d) = &self.defaults {
+                    let z = e.eval_vars(d, 0.0, &[0.0, 0.0]);
+                    if !z.is_finite() {
+                        self.err(
+                            w,
+                            Some("surface"),
+                            Some(s),
+                            format!("surface \"{s}\" is not finite at x = y = 0 with the default parameters: {z}"),
+                        );
+                    }
+                }
+                e
+            }
+            Err(pe) => {
+                let msg = match &pe.kind {
+                    ParseErrorKind::UnknownIdentifier(n) => format!(
+                        "unknown identifier \"{n}\" in surface (\"{s}\"): use x, y (m, in the surface body's frame) and parameters{}",
+                        close_matches(n, self.names.iter().map(String::as_str))
+                    ),
+                    ParseErrorKind::TimeNotAllowed => {
+                        format!("time t is not allowed in surface (\"{s}\")")
+                    }
+                    ParseErrorKind::Syntax { .. } => format!("surface: {pe}"),
+                };
+                self.err(w, Some("surface"), Some(s), msg);
+                Expr::Num(f64::NAN)
+            }
+        }
+    }
+
     fn expr(&mut self, w: &Where, label: &str, key: &str, v: &Value, allow_time: bool) -> Expr {
         match v {
             Value::Num(x) => {
@@ -1744,6 +1785,7 @@ impl Cx<'_> {
                     plane_body,
                     origin,
                     normal,
+                    surface,
                     c,
                     d,
                     ct,
@@ -1777,6 +1819,15 @@ impl Cx<'_> {
                         })
                         .collect();
                     let normal_e = self.vec3(&w, "normal", normal, false);
+                    let surface = surface.as_ref().map(|v| self.surface_expr(&w, v));
+                    if surface.is_some() && *normal != crate::raw::unit_z() {
+                        self.err(
+                            &w,
+                            Some("normal"),
+                            None,
+                            "a Z-surface's normal follows from its slope: leave `normal` out".into(),
+                        );
+                    }
                     if let Some(defs) = &self.defaults {
                         let len2: f64 = normal_e.iter().map(|e| e.eval(defs, 0.0).powi(2)).sum();
                         if len2.is_finite() && len2 == 0.0 {
@@ -1815,6 +1866,7 @@ impl Cx<'_> {
                             }
                         },
                         normal: normal_e,
+                        surface,
                         stiffness,
                         damping,
                         tangential_stiffness,

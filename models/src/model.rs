@@ -221,6 +221,11 @@ pub enum ForceKind {
         origin: [Expr; 3],
         /// Normal pointing out of the plane's solid side (any length > 0).
         normal: [Expr; 3],
+        /// Point–Z-surface variant: instead of the plane, the surface
+        /// z = f(x, y) in the frame of `plane_body` shifted to `origin` (x, y
+        /// are the local variables `Var(0)`, `Var(1)`, m), solid below it; the
+        /// normal is the surface's upward normal (−f_x, −f_y, 1).
+        surface: Option<Expr>,
         /// Normal stiffness per point, N/m.
         stiffness: Expr,
         /// Normal damping per point, N s/m.

@@ -88,12 +88,25 @@ pub fn parse_expr_with(
     allow_time: bool,
     resolve: impl FnMut(&str) -> Option<usize>,
 ) -> Result<Expr, ParseError> {
+    parse_expr_vars(text, allow_time, &[], resolve)
+}
+
+/// Parses `text` where the identifiers `vars[i]` are the local variables
+/// `Var(i)` (they shadow parameters of the same name) and the others resolve
+/// with `resolve`.
+pub fn parse_expr_vars(
+    text: &str,
+    allow_time: bool,
+    vars: &[&str],
+    resolve: impl FnMut(&str) -> Option<usize>,
+) -> Result<Expr, ParseError> {
     let mut p = Parser {
         text,
         chars: text.chars().collect(),
         pos: 0,
         depth: 0,
         allow_time,
+        vars,
         resolve,
     };
     p.skip_ws();
@@ -112,6 +125,7 @@ struct Parser<'a, R> {
     /// Current nesting depth of `unary` (every recursion passes through it).
     depth: usize,
     allow_time: bool,
+    vars: &'a [&'a str],
     resolve: R,
 }
 
@@ -261,6 +275,9 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
                             Err(self.error_at(start, ParseErrorKind::TimeNotAllowed))
                         }
                     }
+                    _ if self.vars.contains(&name.as_str()) => Ok(Expr::Var(
+                        self.vars.iter().position(|v| *v == name).unwrap_or(0),
+                    )),
                     _ => match (self.resolve)(&name) {
                         Some(i) => Ok(Expr::Param(i)),
                         None => Err(self.error_at(start, ParseErrorKind::UnknownIdentifier(name))),

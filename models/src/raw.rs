@@ -165,7 +165,7 @@ fn ground_name() -> String {
     "ground".into()
 }
 
-fn unit_z() -> Vec3 {
+pub(crate) fn unit_z() -> Vec3 {
     (Value::Num(0.0), Value::Num(0.0), Value::Num(1.0))
 }
 
@@ -500,6 +500,8 @@ pub(crate) enum RawForce {
         origin: Vec3,
         #[serde(default = "unit_z")]
         normal: Vec3,
+        #[serde(default, deserialize_with = "some_value")]
+        surface: Option<Value>,
         c: Value,
         #[serde(default)]
         d: Value,

@@ -79,6 +79,7 @@ impl ForceKind {
                 points,
                 origin,
                 normal,
+                surface,
                 stiffness,
                 damping,
                 tangential_stiffness,
@@ -89,6 +90,7 @@ impl ForceKind {
             } => {
                 points.iter_mut().flatten().for_each(&mut *f);
                 origin.iter_mut().chain(normal.iter_mut()).for_each(&mut *f);
+                surface.iter_mut().for_each(&mut *f);
                 for e in [
                     stiffness,
                     damping,

@@ -2,7 +2,7 @@
 //! derivatives against central differences, display round trip.
 
 use proptest::prelude::*;
-use railmbs_models::{Expr, Func, ParseErrorKind, parse_expr};
+use railmbs_models::{Expr, Func, ParseErrorKind, VAR_NAMES, parse_expr, parse_expr_vars};
 use std::f64::consts::PI;
 
 fn names() -> Vec<String> {
@@ -147,6 +147,41 @@ fn time_derivative_matches_central_differences() {
             );
         }
     }
+}
+
+#[test]
+fn local_variables_evaluate_and_differentiate() {
+    let names = names();
+    let resolve = |id: &str| names.iter().position(|n| n == id);
+    let e = parse_expr_vars("a*x^2*y + sin(b*y) - x/WS1.r0", false, &VAR_NAMES, resolve).unwrap();
+    assert!(e.has_vars() && !e.has_time());
+    let (x, y) = (0.3, -0.7);
+    let want = 2.0 * x * x * y + (3.0 * y as f64).sin() - x / 0.46;
+    assert!((e.eval_vars(&P, 0.0, &[x, y]) - want).abs() < 1e-15);
+    // Without the variables bound the value is NaN, never a silent number.
+    assert!(e.eval(&P, 0.0).is_nan());
+    for (i, exact) in [
+        (0, 4.0 * x * y - 1.0 / 0.46),
+        (1, 2.0 * x * x + 3.0 * (3.0 * y as f64).cos()),
+    ] {
+        let d = e.var_derivative(i).eval_vars(&P, 0.0, &[x, y]);
+        assert!(
+            (d - exact).abs() < 1e-14,
+            "d/d{}: {d} vs {exact}",
+            VAR_NAMES[i]
+        );
+    }
+    // A variable shadows a parameter of the same name; `z` is unknown.
+    assert_eq!(
+        parse_expr_vars("x", false, &VAR_NAMES, |_| Some(0)).unwrap(),
+        Expr::Var(0)
+    );
+    assert!(matches!(
+        parse_expr_vars("z", false, &VAR_NAMES, resolve)
+            .unwrap_err()
+            .kind,
+        ParseErrorKind::UnknownIdentifier(_)
+    ));
 }
 
 #[test]

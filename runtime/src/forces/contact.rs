@@ -86,6 +86,9 @@ pub struct PointPlane {
     plane_body: Option<usize>,
     origin_expr: [Expr; 3],
     normal_expr: [Expr; 3],
+    /// Point–Z-surface variant: the height f(x, y) and its slopes f_x, f_y
+    /// (expressions in the local variables x, y and the parameters).
+    surface: Option<[Expr; 3]>,
     coeff_expr: [Expr; 6],
     /// Plane point and unit normal in the plane body's frame.
     origin: Vector3<f64>,
@@ -137,6 +140,7 @@ impl PointPlane {
             plane_body,
             origin,
             normal,
+            surface,
             stiffness,
             damping,
             tangential_stiffness,
@@ -156,6 +160,9 @@ impl PointPlane {
             },
             origin_expr: origin.clone(),
             normal_expr: normal.clone(),
+            surface: surface
+                .as_ref()
+                .map(|f| [f.clone(), f.var_derivative(0), f.var_derivative(1)]),
             coeff_expr: [
                 stiffness.clone(),
                 damping.clone(),
@@ -216,11 +223,46 @@ impl PointPlane {
         }
     }
 
+    /// The plane the point `p` (SC0) touches: a point of it and its unit
+    /// outward normal (SC0). For a Z-surface, the tangent plane at the
+    /// surface point above or below p: with (x, y, z) the position of p in the
+    /// surface frame (plane body's frame shifted to `origin`), the surface
+    /// point (x, y, f(x, y)) and the normal (−f_x, −f_y, 1)/√(1 + f_x² + f_y²).
+    /// The penetration −n·(p − o) = (f − z)/√(1 + f_x² + f_y²) is then the
+    /// distance to the tangent plane: exact for planar surfaces, to second
+    /// order in the slope change over the gap for curved ones.
+    fn contact_plane(&self, ctx: &ForceContext, p: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let Some([f, fx, fy]) = &self.surface else {
+            let (o, n, _) = self.plane(ctx);
+            return (o, n);
+        };
+        let local = self.to_plane(ctx, p) - self.origin;
+        let xy = [local.x, local.y];
+        let z = f.eval_vars(ctx.params, ctx.t, &xy);
+        let (sx, sy) = (
+            fx.eval_vars(ctx.params, ctx.t, &xy),
+            fy.eval_vars(ctx.params, ctx.t, &xy),
+        );
+        let n_local = Vector3::new(-sx, -sy, 1.0).normalize();
+        let o_local = self.origin + Vector3::new(local.x, local.y, z);
+        match self.plane_body {
+            Some(b) => (
+                ctx.bodies[b].point_position(&o_local),
+                ctx.bodies[b].rotation * n_local,
+            ),
+            None => (o_local, n_local),
+        }
+    }
+
     /// The contact of point k, or None when it does not penetrate.
     fn evaluate(&self, ctx: &ForceContext, k: usize) -> Option<PointEval> {
-        let (o, n, _) = self.plane(ctx);
         let att = &self.points[k];
         let p = att.position(ctx);
+        let (o, n) = self.contact_plane(ctx, &p);
+        if !(o.iter().chain(n.iter()).all(|x| x.is_finite())) {
+            // Outside a surface's domain; `apply` reports it as an error.
+            return None;
+        }
         let delta = -n.dot(&(p - o));
         if delta <= 0.0 {
             return None;
@@ -344,6 +386,23 @@ impl ForceElement for PointPlane {
 
     fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
         let body = self.body();
+        if self.surface.is_some() {
+            for (k, att) in self.points.iter().enumerate() {
+                let p = att.position(ctx);
+                let (o, n) = self.contact_plane(ctx, &p);
+                if !(o.iter().chain(n.iter()).all(|x| x.is_finite())) {
+                    let local = self.to_plane(ctx, &p) - self.origin;
+                    return Err(SimError::NonFinite {
+                        t: ctx.t,
+                        what: format!(
+                            "force element \"{}\": the surface or its slope is not finite under \
+                             point {k} (x = {} m, y = {} m in the surface frame)",
+                            self.name, local.x, local.y
+                        ),
+                    });
+                }
+            }
+        }
         for k in 0..self.points.len() {
             if let Some(e) = self.evaluate(ctx, k) {
                 let f = e.normal_force * e.n + e.ft;
