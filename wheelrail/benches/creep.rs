@@ -3,11 +3,12 @@
 //! `cargo bench -p railmbs-wheelrail --bench creep`; criterion reports the
 //! throughput in elements/s = evaluations/s over a fixed set of 64 tread-contact
 //! cases (creepages from adhesion-dominated to near saturation, spin up to
-//! 0.3 1/m).
+//! 0.3 1/m). `-- "creep/fastsim-a"` (a criterion filter) runs one group of laws.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller, Polach,
+    SlidingZone,
 };
 use std::hint::black_box;
 
@@ -50,6 +51,34 @@ fn bench(c: &mut Criterion) {
         ),
         ("fastsim-a 10".into(), Box::new(FastsimA::new(10).unwrap())),
         ("fastsim-a 20".into(), Box::new(FastsimA::new(20).unwrap())),
+        (
+            "fastsim-a 10 integrated".into(),
+            Box::new(FastsimA::integrated(10).unwrap()),
+        ),
+        (
+            "fastsim-a 20 integrated".into(),
+            Box::new(FastsimA::integrated(20).unwrap()),
+        ),
+        (
+            "fastsim-a 10 picard 8".into(),
+            Box::new(
+                FastsimA::new(10)
+                    .unwrap()
+                    .with_sliding(SlidingZone::Picard { nodes: 8 })
+                    .unwrap(),
+            ),
+        ),
+        ("polach".into(), Box::new(Polach::new())),
+        (
+            "polach 2005 options".into(),
+            Box::new(
+                Polach::new()
+                    .with_reduction(0.3, 0.1)
+                    .unwrap()
+                    .with_falling_friction(0.4, 0.6, 30.0)
+                    .unwrap(),
+            ),
+        ),
     ];
     let mut g = c.benchmark_group("creep");
     g.throughput(Throughput::Elements(cs.len() as u64));

@@ -23,7 +23,7 @@ mod fastsim_a;
 mod polach;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
-pub use fastsim_a::FastsimA;
+pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
 pub use polach::Polach;
 
 pub use crate::creepage::Creepages;
