@@ -1,9 +1,15 @@
 //! `umsim creep`: creep forces for a table of contact cases.
 //!
 //! ```text
-//! umsim creep --method kalker|mueller|fastsim|fastsim-a [--strips M] [--elements N] \
-//!             --cases FILE.csv [-o out.csv]
+//! umsim creep --method kalker|mueller|fastsim|fastsim-a|polach [--strips M] [--elements N] \
+//!             [--sliding continuation|integrated|picard] [--nodes K] --cases FILE.csv [-o out.csv]
 //! ```
+//!
+//! `--sliding` selects FastSim_A's treatment of the sliding zones (default
+//! `continuation`; `integrated` is more accurate at large spin, about ten times
+//! slower; see `railmbs_wheelrail::creep::SlidingZone`), with `--nodes` Gauss
+//! nodes per zone (default 8). `polach` is Polach's 1999 law (constant
+//! friction, no reduction factors).
 //!
 //! Input columns (any order, by header name): `a,b,G,nu,mu,N,xi,eta,phi` in
 //! m, m, Pa, –, –, N, –, –, 1/m. Output columns `Fx,Fy,Mz` in N, N, N·m: forces
@@ -12,7 +18,8 @@
 //! row number, 1-based, and file line) and the column.
 
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller, Polach,
+    SlidingZone,
 };
 use std::io::{Read, Write};
 use std::path::PathBuf;
@@ -28,6 +35,19 @@ pub enum Method {
     Fastsim,
     /// Semi-analytic FastSim_A, strips only.
     FastsimA,
+    /// Polach's method (1999; spin included).
+    Polach,
+}
+
+/// FastSim_A's treatment of the sliding zones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Sliding {
+    /// Adhesion-continuation direction in closed form (fastest).
+    Continuation,
+    /// Sliding zone integrated node to node, with re-adhesion.
+    Integrated,
+    /// One Picard step from the continuation direction.
+    Picard,
 }
 
 /// Arguments of `umsim creep`.
@@ -42,6 +62,12 @@ pub struct Args {
     /// Number of elements per strip (FASTSIM).
     #[arg(long, default_value_t = 10)]
     pub elements: usize,
+    /// FastSim_A's treatment of the sliding zones.
+    #[arg(long, value_enum, default_value_t = Sliding::Continuation)]
+    pub sliding: Sliding,
+    /// Gauss nodes per sliding zone (FastSim_A with `--sliding integrated|picard`).
+    #[arg(long, default_value_t = railmbs_wheelrail::creep::INTEGRATED_NODES)]
+    pub nodes: usize,
     /// Input CSV with columns a,b,G,nu,mu,N,xi,eta,phi.
     #[arg(long)]
     pub cases: PathBuf,
@@ -52,13 +78,39 @@ pub struct Args {
 
 const COLUMNS: [&str; 9] = ["a", "b", "G", "nu", "mu", "N", "xi", "eta", "phi"];
 
-/// Builds the law for the arguments.
+/// Builds the law for the arguments (FastSim_A with the continuation
+/// direction).
 pub fn law(method: Method, strips: usize, elements: usize) -> Result<Box<dyn CreepLaw>, String> {
+    law_with_sliding(method, strips, elements, Sliding::Continuation, 0)
+}
+
+/// Builds the law for the arguments, FastSim_A with the given sliding-zone
+/// treatment and Gauss nodes per zone.
+pub fn law_with_sliding(
+    method: Method,
+    strips: usize,
+    elements: usize,
+    sliding: Sliding,
+    nodes: usize,
+) -> Result<Box<dyn CreepLaw>, String> {
+    let err = |e: railmbs_wheelrail::creep::CreepError| e.to_string();
     Ok(match method {
         Method::Kalker => Box::new(KalkerLinear),
         Method::Mueller => Box::new(Mueller::default()),
-        Method::Fastsim => Box::new(Fastsim::new(strips, elements).map_err(|e| e.to_string())?),
-        Method::FastsimA => Box::new(FastsimA::new(strips).map_err(|e| e.to_string())?),
+        Method::Fastsim => Box::new(Fastsim::new(strips, elements).map_err(err)?),
+        Method::FastsimA => {
+            let zone = match sliding {
+                Sliding::Continuation => SlidingZone::Continuation,
+                Sliding::Integrated => SlidingZone::Integrated { nodes },
+                Sliding::Picard => SlidingZone::Picard { nodes },
+            };
+            Box::new(
+                FastsimA::new(strips)
+                    .and_then(|l| l.with_sliding(zone))
+                    .map_err(err)?,
+            )
+        }
+        Method::Polach => Box::new(Polach::new()),
     })
 }
 
@@ -138,7 +190,13 @@ pub fn evaluate<R: Read, W: Write>(
 
 /// Runs `umsim creep`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let law = law(args.method, args.strips, args.elements)?;
+    let law = law_with_sliding(
+        args.method,
+        args.strips,
+        args.elements,
+        args.sliding,
+        args.nodes,
+    )?;
     let source = args.cases.display().to_string();
     let file = std::fs::File::open(&args.cases).map_err(|e| format!("{source}: {e}"))?;
     match &args.output {
@@ -175,6 +233,7 @@ mod tests {
             Method::Mueller,
             Method::Fastsim,
             Method::FastsimA,
+            Method::Polach,
         ] {
             let out = run_str(m, input).unwrap();
             let lines: Vec<&str> = out.lines().collect();
