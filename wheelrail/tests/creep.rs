@@ -316,6 +316,10 @@ fn fastsim_a_against_fine_fastsim() {
             }
             let c = Creepages { xi, eta, phi: 0.0 };
             let r = fine.forces(&p, &c).unwrap();
+            // Without spin the corrections vanish identically.
+            let f = fsa.forces(&p, &c).unwrap();
+            assert_eq!(integ.forces(&p, &c).unwrap(), f);
+            assert_eq!(picard.forces(&p, &c).unwrap(), f);
             for law in [&fsa, &integ, &picard] {
                 let e = rel_total(&law.forces(&p, &c).unwrap(), &r);
                 assert!(e < 2e-3, "zero spin ξ {xi} η {eta}: {e}");
