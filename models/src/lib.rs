@@ -120,6 +120,15 @@
 //! // beyond the end rows; deflection m increasing, force N) plus d·ẋ. A bump stop:
 //! Tabulated(name: "stop", body1: "a", body2: "b", table: [(-0.02, -2e4), (-0.01, 0), (0.01, 0), (0.02, 2e4)],
 //!           d: 100, x0: 0.5),
+//! // `interpolation: Spline` (default `Linear`): monotone piecewise cubic through
+//! // the rows (Fritsch–Carlson), continuous slope, no overshoot between rows.
+//! Tabulated(name: "stop2", body1: "a", body2: "b", table: [(-0.02, -2e4), (-0.01, 0), (0.01, 0), (0.02, 2e4)],
+//!           interpolation: Spline, x0: 0.5),
+//! // Linear6 helper for a coil spring (frames at its lower plate): vertical,
+//! // shear, bending (N m/rad) and torsion stiffness and the height H; shear and
+//! // tilt couple by ±c_s·H/2. Also usable for `damping`.
+//! Linear6(name: "coil", body1: "a", body2: "b",
+//!         stiffness: VerticalSpring(vertical: 1.2e6, shear: 3e5, bending: 4e4, torsion: 2e4, height: 0.4)),
 //! // Stiffness c in series with damping d (a Maxwell element), preload f0 in
 //! // parallel: F = c·s + f0 with d·(ẋ − ṡ) = c·s. The spring extension s is a
 //! // first-order state `<name>.s` integrated with q (Park's method only; RK4

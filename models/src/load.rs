@@ -1594,6 +1594,43 @@ impl Cx<'_> {
                     out[7 * k] = e;
                 }
             }
+            RawMatrix6::VerticalSpring {
+                vertical,
+                shear,
+                bending,
+                torsion,
+                height,
+            } => {
+                // Energy ½ c_s |s|² + ½ c_b (θx² + θy²) + ½ c_z u_z² + ½ c_t θz²,
+                // the shear s = (u_x + θy H/2, u_y − θx H/2) being the offset of
+                // the upper plate's material point at mid-height (frames at the
+                // lower plate; u, θ the upper body's displacement and rotation
+                // there). Its Hessian couples shear and tilt by ±c_s H/2.
+                let e = |this: &mut Self, name: &str, v: &Value| {
+                    this.expr(w, &format!("{key}.{name}"), key, v, false)
+                };
+                let cz = e(self, "vertical", vertical);
+                let cs = e(self, "shear", shear);
+                let cb = e(self, "bending", bending);
+                let ct = e(self, "torsion", torsion);
+                let h = e(self, "height", height);
+                let half = Expr::Div(Box::new(h), Box::new(Expr::Num(2.0)));
+                let cs_half = Expr::Mul(Box::new(cs.clone()), Box::new(half.clone()));
+                let tilt = Expr::Add(
+                    Box::new(cb),
+                    Box::new(Expr::Mul(Box::new(cs_half.clone()), Box::new(half))),
+                );
+                out[0] = cs.clone();
+                out[7] = cs;
+                out[14] = cz;
+                out[21] = tilt.clone();
+                out[28] = tilt;
+                out[35] = ct;
+                out[4] = cs_half.clone(); // (u_x, θy)
+                out[24] = cs_half.clone();
+                out[9] = Expr::Neg(Box::new(cs_half.clone())); // (u_y, θx)
+                out[19] = Expr::Neg(Box::new(cs_half));
+            }
             RawMatrix6::Full(v) => {
                 if v.len() != 36 {
                     self.err(
@@ -1962,6 +1999,7 @@ impl Cx<'_> {
                     body2,
                     point2,
                     table,
+                    interpolation,
                     d,
                     x0,
                     ..
@@ -2011,6 +2049,7 @@ impl Cx<'_> {
                         body2,
                         point2,
                         table: rows,
+                        interpolation: *interpolation,
                         damping,
                         free_length: self.expr(&w, "x0", "x0", x0, false),
                     }

@@ -145,6 +145,19 @@ pub enum VectorFrame {
     Body,
 }
 
+/// How a tabulated characteristic is interpolated between its rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+pub enum Interpolation {
+    /// Straight lines between the rows (kinks at the rows).
+    #[default]
+    Linear,
+    /// Piecewise cubic Hermite with Fritsch–Carlson slopes (Fritsch &
+    /// Carlson 1980, SIAM J. Numer. Anal. 17): continuous slope, through every
+    /// row, and monotone wherever the rows are (no overshoot in a bump stop's
+    /// clearance, as a C² interpolating spline would give).
+    Spline,
+}
+
 /// Force elements of the model. The runtime computes their forces; the model
 /// only describes them. Each variant's fields are expressions over parameters
 /// (and `t` where stated).
@@ -284,6 +297,8 @@ pub enum ForceKind {
         point2: [Expr; 3],
         /// (deflection m, force N), deflection increasing.
         table: Vec<(Expr, Expr)>,
+        /// Between the rows: straight lines, or a monotone cubic.
+        interpolation: Interpolation,
         /// N s/m.
         damping: Expr,
         /// m.

@@ -1,7 +1,7 @@
 //! The RON syntax of model files as serde types, before resolution: names are
 //! still strings and numeric fields are numbers or expression text.
 
-use crate::model::Axis;
+use crate::model::{Axis, Interpolation};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, de::IgnoredAny};
 use std::fmt;
@@ -426,6 +426,16 @@ pub(crate) struct RawCutJoint {
 pub(crate) enum RawMatrix6 {
     Diag(Vec6),
     Full(Vec<Value>),
+    /// A coil spring between its lower and upper plates (frames at the lower
+    /// plate): vertical, shear, bending and torsion stiffness (or damping)
+    /// and the height.
+    VerticalSpring {
+        vertical: Value,
+        shear: Value,
+        bending: Value,
+        torsion: Value,
+        height: Value,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
@@ -554,6 +564,8 @@ pub(crate) enum RawForce {
         #[serde(default = "zero3")]
         point2: Vec3,
         table: Vec<(Value, Value)>,
+        #[serde(default)]
+        interpolation: Interpolation,
         #[serde(default)]
         d: Value,
         #[serde(default)]

@@ -190,3 +190,55 @@ fn table_is_checked() {
         "table deflections must increase: row 2 has 0.5 after 0.5",
     );
 }
+
+/// The vertical-spring helper of `Linear6` (a coil spring with vertical,
+/// shear, bending and torsion stiffness and height H, frames at its lower
+/// plate) against the mechanics of the spring: a pure shear of the upper
+/// plate (translation u_x) is resisted by the shear force c_s u_x acting at
+/// mid-height, i.e. with the moment c_s u_x H/2 about the lower plate; a tilt
+/// of the upper body about the spring's mid-height point (translation
+/// −θ H/2 at the lower plate, no shear) only bends it: moment c_b θ, no force.
+#[test]
+fn vertical_spring_helper_gives_the_coil_spring_stiffness() {
+    let (cz, cs, cb, ct, h) = (1.2e6, 3.0e5, 4.0e4, 2.0e4, 0.4);
+    let element = format!(
+        "Linear6(name: \"coil\", body1: \"a\", body2: \"b\", \
+         stiffness: VerticalSpring(vertical: {cz}, shear: {cs}, bending: {cb}, torsion: {ct}, height: {h}))"
+    );
+    let text = BASE.replacen("c: \"k\"),", &format!("c: \"k\"),\n        {element},"), 1);
+    let m = load(&text).unwrap_or_else(|e| panic!("{e}"));
+    let ForceKind::Linear6 { stiffness, .. } = &m.forces[1].kind else {
+        panic!("{:?}", m.forces[1].kind)
+    };
+    let c: Vec<f64> = stiffness.iter().map(|e| e.eval(&[], 0.0)).collect();
+    let times = |d: [f64; 6]| -> Vec<f64> {
+        (0..6)
+            .map(|r| (0..6).map(|k| c[6 * r + k] * d[k]).sum())
+            .collect()
+    };
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+    // Symmetric (it is a Hessian).
+    for r in 0..6 {
+        for k in 0..6 {
+            assert_eq!(c[6 * r + k], c[6 * k + r]);
+        }
+    }
+    let u = 1e-3;
+    let w = times([u, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    assert!(
+        close(w[0], cs * u) && close(w[4], cs * u * h / 2.0),
+        "{w:?}"
+    );
+    let w = times([0.0, u, 0.0, 0.0, 0.0, 0.0]);
+    assert!(
+        close(w[1], cs * u) && close(w[3], -cs * u * h / 2.0),
+        "{w:?}"
+    );
+    let th = 2e-3;
+    let w = times([-th * h / 2.0, 0.0, 0.0, 0.0, th, 0.0]);
+    assert!(close(w[0], 0.0) && close(w[4], cb * th), "{w:?}");
+    let w = times([0.0, th * h / 2.0, 0.0, th, 0.0, 0.0]);
+    assert!(close(w[1], 0.0) && close(w[3], cb * th), "{w:?}");
+    let w = times([0.0, 0.0, u, 0.0, 0.0, th]);
+    assert!(close(w[2], cz * u) && close(w[5], ct * th), "{w:?}");
+}

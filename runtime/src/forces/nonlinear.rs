@@ -25,7 +25,7 @@ use super::bipolar::TwoPoint;
 use super::{ForceContext, ForceElement, ForceJacobian, Wrench, eval_scalar};
 use crate::system::SimError;
 
-use railmbs_models::{Expr, ForceKind};
+use railmbs_models::{Expr, ForceKind, Interpolation};
 
 /// Velocity below which the sign of the sliding velocity is regularized
 /// linearly, m/s.
@@ -449,10 +449,13 @@ pub struct Tabulated {
     table_expr: Vec<(Expr, Expr)>,
     damping_expr: Expr,
     x0_expr: Expr,
+    interpolation: Interpolation,
     /// Deflections, m (increasing).
     pub deflections: Vec<f64>,
     /// Forces, N.
     pub forces: Vec<f64>,
+    /// Slopes at the rows (N/m) of the cubic interpolation.
+    slopes: Vec<f64>,
     /// N s/m.
     pub damping: f64,
     /// m.
@@ -468,6 +471,7 @@ impl Tabulated {
             body2,
             point2,
             table,
+            interpolation,
             damping,
             free_length,
         } = kind
@@ -480,8 +484,10 @@ impl Tabulated {
             table_expr: table.clone(),
             damping_expr: damping.clone(),
             x0_expr: free_length.clone(),
+            interpolation: *interpolation,
             deflections: Vec::new(),
             forces: Vec::new(),
+            slopes: Vec::new(),
             damping: 0.0,
             free_length: 0.0,
         }
@@ -496,8 +502,71 @@ impl Tabulated {
             0 => 0,
             i => (i - 1).min(xs.len() - 2),
         };
-        let slope = (fs[k + 1] - fs[k]) / (xs[k + 1] - xs[k]);
-        (fs[k] + slope * (u - xs[k]), slope)
+        let dx = xs[k + 1] - xs[k];
+        let secant = (fs[k + 1] - fs[k]) / dx;
+        if self.interpolation == Interpolation::Linear {
+            return (fs[k] + secant * (u - xs[k]), secant);
+        }
+        let n = xs.len();
+        // Beyond the end rows: straight on with the end slope.
+        if u < xs[0] {
+            return (fs[0] + self.slopes[0] * (u - xs[0]), self.slopes[0]);
+        }
+        if u > xs[n - 1] {
+            return (
+                fs[n - 1] + self.slopes[n - 1] * (u - xs[n - 1]),
+                self.slopes[n - 1],
+            );
+        }
+        // Cubic Hermite on the segment in s = (u − x_k)/Δx.
+        let s = (u - xs[k]) / dx;
+        let (m0, m1) = (self.slopes[k] * dx, self.slopes[k + 1] * dx);
+        let (s2, s3) = (s * s, s * s * s);
+        let f = (2.0 * s3 - 3.0 * s2 + 1.0) * fs[k]
+            + (s3 - 2.0 * s2 + s) * m0
+            + (-2.0 * s3 + 3.0 * s2) * fs[k + 1]
+            + (s3 - s2) * m1;
+        let df = ((6.0 * s2 - 6.0 * s) * fs[k]
+            + (3.0 * s2 - 4.0 * s + 1.0) * m0
+            + (-6.0 * s2 + 6.0 * s) * fs[k + 1]
+            + (3.0 * s2 - 2.0 * s) * m1)
+            / dx;
+        (f, df)
+    }
+
+    /// Fritsch–Carlson slopes: the harmonic-type three-point estimate inside
+    /// (zero where the secants change sign or one vanishes), one-sided at the
+    /// ends, then limited so that α² + β² ≤ 9 on every segment (α, β the end
+    /// slopes over the secant), which keeps each segment monotone.
+    fn monotone_slopes(&mut self) {
+        let (xs, fs) = (&self.deflections, &self.forces);
+        let n = xs.len();
+        let secants: Vec<f64> = (0..n - 1)
+            .map(|k| (fs[k + 1] - fs[k]) / (xs[k + 1] - xs[k]))
+            .collect();
+        let mut m = vec![0.0; n];
+        m[0] = secants[0];
+        m[n - 1] = secants[n - 2];
+        for k in 1..n - 1 {
+            let (a, b) = (secants[k - 1], secants[k]);
+            m[k] = if a * b <= 0.0 { 0.0 } else { 0.5 * (a + b) };
+        }
+        for k in 0..n - 1 {
+            let d = secants[k];
+            if d == 0.0 {
+                m[k] = 0.0;
+                m[k + 1] = 0.0;
+                continue;
+            }
+            let (a, b) = (m[k] / d, m[k + 1] / d);
+            let r = a * a + b * b;
+            if r > 9.0 {
+                let t = 3.0 / r.sqrt();
+                m[k] = t * a * d;
+                m[k + 1] = t * b * d;
+            }
+        }
+        self.slopes = m;
     }
 }
 
@@ -532,6 +601,9 @@ impl ForceElement for Tabulated {
         }
         self.damping = eval_scalar(&self.damping_expr, params, &self.name, "damping d")?;
         self.free_length = eval_scalar(&self.x0_expr, params, &self.name, "free length x0")?;
+        if self.interpolation == Interpolation::Spline {
+            self.monotone_slopes();
+        }
         Ok(())
     }
 

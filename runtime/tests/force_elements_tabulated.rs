@@ -1,0 +1,151 @@
+//! Tabulated characteristics with monotone cubic interpolation
+//! (`interpolation: Spline`, Fritsch & Carlson 1980): through every row, a
+//! continuous slope, no overshoot in a bump stop's clearance, quadratics
+//! reproduced exactly inside the table (the three-point slope is exact for
+//! them), and the element's Jacobian against central differences.
+
+use std::path::Path;
+
+use nalgebra::{DMatrix, DVector};
+use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
+
+/// One translating body on a tabulated element along x (x0 = 0.5: the
+/// deflection is the coordinate).
+fn model(table: &str, interpolation: &str) -> String {
+    format!(
+        r#"
+Model(
+    name: "tab",
+    gravity: (0, 0, 0),
+    bodies: [
+        Body(name: "b", mass: 1, inertia: (ixx: 1, iyy: 1, izz: 1),
+             joint: Joint(parent: "ground", transforms: [
+                Tx((coord: "u", init: 0.5, vel: 0.1)), Ty((coord: "v", init: 0.05))])),
+    ],
+    forces: [
+        Tabulated(name: "tab", body1: "ground", body2: "b", table: {table},
+                  interpolation: {interpolation}, d: 20, x0: 0.5),
+    ],
+)
+"#
+    )
+}
+
+fn system(text: &str) -> (ModelSystem, Vec<f64>, Vec<f64>) {
+    let m =
+        railmbs_models::parse_model(text, Path::new("tab.ron")).unwrap_or_else(|e| panic!("{e}"));
+    let params = m.parameter_values(&[], &[]).unwrap();
+    let (q, v) = m.initial_state(&params);
+    (
+        ModelSystem::new(&m, Box::new(NumericEquations::new(&m)), params).unwrap(),
+        q,
+        v,
+    )
+}
+
+/// The element's characteristic f(u) (N) at deflection u, read from its
+/// output at rest (no damping force) on the x axis.
+fn characteristic(sys: &mut ModelSystem, u: f64) -> f64 {
+    let (q, v) = ([0.5 + u, 0.0], [0.0, 0.0]);
+    sys.evaluate(0.0, &q, &v, railmbs_runtime::Parts::KINEMATICS)
+        .unwrap();
+    let mut out = Vec::new();
+    sys.force_outputs(0.0, &mut out);
+    out[0]
+}
+
+#[test]
+fn spline_reproduces_a_quadratic_inside_the_table() {
+    // f = 1e4·u² on rows u = 0, 0.01, …, 0.05: interior segments exact.
+    let rows: Vec<String> = (0..6)
+        .map(|k| {
+            let u = 0.01 * k as f64;
+            format!("({u}, {})", 1e4 * u * u)
+        })
+        .collect();
+    let (mut sys, ..) = system(&model(&format!("[{}]", rows.join(", ")), "Spline"));
+    for k in 0..=40 {
+        let u = 0.01 + 0.03 * k as f64 / 40.0;
+        let f = characteristic(&mut sys, u);
+        assert!(
+            (f - 1e4 * u * u).abs() < 1e-9,
+            "f({u}) = {f}, exact {}",
+            1e4 * u * u
+        );
+    }
+}
+
+#[test]
+fn spline_bump_stop_passes_the_rows_without_overshoot() {
+    // Clearance ±10 mm, then a progressive stop.
+    let table =
+        "[(-0.03, -6e4), (-0.02, -1.5e4), (-0.01, 0), (0.01, 0), (0.02, 1.5e4), (0.03, 6e4)]";
+    let rows = [
+        (-0.03, -6e4),
+        (-0.02, -1.5e4),
+        (-0.01, 0.0),
+        (0.01, 0.0),
+        (0.02, 1.5e4),
+        (0.03, 6e4),
+    ];
+    let (mut sys, ..) = system(&model(table, "Spline"));
+    for (u, f) in rows {
+        assert!((characteristic(&mut sys, u) - f).abs() < 1e-9, "row {u}");
+    }
+    // Monotone non-decreasing everywhere, exactly zero in the clearance.
+    let mut prev = f64::NEG_INFINITY;
+    for k in 0..=800 {
+        let u = -0.04 + 0.08 * k as f64 / 800.0;
+        let f = characteristic(&mut sys, u);
+        assert!(f >= prev - 1e-9, "not monotone at u = {u}: {prev} then {f}");
+        if u.abs() <= 0.01 {
+            assert_eq!(f, 0.0, "overshoot in the clearance at u = {u}");
+        }
+        prev = f;
+    }
+    // Continuous slope at an interior row (left and right difference
+    // quotients agree to O(h)); the linear table has a kink there.
+    let slope_jump = |sys: &mut ModelSystem| {
+        let (u, h) = (0.02, 1e-7);
+        let left = (characteristic(sys, u) - characteristic(sys, u - h)) / h;
+        let right = (characteristic(sys, u + h) - characteristic(sys, u)) / h;
+        (right - left).abs()
+    };
+    assert!(
+        slope_jump(&mut sys) < 1e-2 * 4.5e6,
+        "{}",
+        slope_jump(&mut sys)
+    );
+    let (mut linear, ..) = system(&model(table, "Linear"));
+    assert!(slope_jump(&mut linear) > 1e6);
+}
+
+#[test]
+fn spline_element_jacobian_equals_central_differences() {
+    let table =
+        "[(-0.03, -6e4), (-0.02, -1.5e4), (-0.01, 0), (0.01, 0), (0.02, 1.5e4), (0.03, 6e4)]";
+    let (mut sys, mut q, v) = system(&model(table, "Spline"));
+    q[0] = 0.5 + 0.0237; // inside a cubic segment
+    let n = q.len();
+    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+    sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap();
+    let mut mass = DMatrix::zeros(n, n);
+    let (mut fp, mut fm) = (DVector::zeros(n), DVector::zeros(n));
+    for j in 0..n {
+        let h = 1e-7;
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[j] += h;
+        qm[j] -= h;
+        sys.dynamics(0.0, &qp, &v, &mut mass, &mut fp).unwrap();
+        sys.dynamics(0.0, &qm, &v, &mut mass, &mut fm).unwrap();
+        let col = (&fp - &fm) / (2.0 * h);
+        // Forces ~3e4 N, h = 1e-7 m: rounding ε·3e4/h ≈ 7e-5 N/m, truncation
+        // f'''h²/6 ≈ negligible: 1e-7 of the largest entry (~4e6 N/m).
+        assert!(
+            (col - dq.column(j)).amax() < 1e-7 * dq.amax(),
+            "column {j}: {} vs {}",
+            (&fp - &fm) / (2.0 * h),
+            dq.column(j)
+        );
+    }
+}
