@@ -286,7 +286,10 @@
 //!     end_time: 10.0,
 //!     integrator: Park(rtol: 1e-6, atol: 1e-8, max_step: 0.01, initial_step: 1e-4,
 //!                      jacobian: FiniteDifference),  // or Rk4(step: 0.001)
-//!     output: (interval: 0.01, coordinates: true, velocities: false, bodies: [], forces: []),
+//!     output: (interval: 0.01, coordinates: true, velocities: false, bodies: [], forces: [],
+//!              // optional: points (body frame, m) whose kinematic acceleration,
+//!              // in the body's frame, is written as <name>.ax[m/s2], .ay, .az
+//!              accelerometers: { "tip": ("link2", (0, -0.5, 0)) }),
 //!     output_file: "double_pendulum.csv",           // optional, relative to this file
 //! )
 //! ```

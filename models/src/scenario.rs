@@ -61,6 +61,20 @@ pub struct OutputSpec {
     pub bodies: Vec<String>,
     /// Force elements whose forces are written (`<element>.F` …); `["*"]` for all.
     pub forces: Vec<String>,
+    /// Points whose accelerations are written (`<name>.ax[m/s2]`, `.ay`,
+    /// `.az`): in the frame of their body, kinematic (gravity not included).
+    pub accelerometers: Vec<Accelerometer>,
+}
+
+/// An acceleration output: a point fixed to a body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Accelerometer {
+    /// Column prefix.
+    pub name: String,
+    /// Body name.
+    pub body: String,
+    /// The point in the body's frame, m.
+    pub point: [f64; 3],
 }
 
 /// The track a vehicle runs on (for models with track-following frames).
@@ -192,6 +206,8 @@ struct RawOutput {
     bodies: Vec<String>,
     #[serde(default)]
     forces: Vec<String>,
+    #[serde(default)]
+    accelerometers: OrderedMap<(String, (f64, f64, f64))>,
 }
 
 /// Reads a scenario file. The model path and the output file are resolved
@@ -421,6 +437,27 @@ fn common(
             velocities: raw_output.velocities,
             bodies: raw_output.bodies,
             forces: raw_output.forces,
+            accelerometers: {
+                let mut out: Vec<Accelerometer> = Vec::new();
+                for (name, (body, (x, y, z))) in raw_output.accelerometers.0 {
+                    check(
+                        !out.iter().any(|a| a.name == name),
+                        "accelerometers",
+                        format!("accelerometer \"{name}\" is given twice"),
+                    );
+                    check(
+                        [x, y, z].iter().all(|c| c.is_finite()),
+                        "accelerometers",
+                        format!("accelerometer \"{name}\": the point must be finite"),
+                    );
+                    out.push(Accelerometer {
+                        name,
+                        body,
+                        point: [x, y, z],
+                    });
+                }
+                out
+            },
         },
         track,
         parameters,
@@ -964,6 +1001,17 @@ impl TrainScenario {
                 velocities: self.output.velocities,
                 bodies: mine(&self.output.bodies),
                 forces: mine(&self.output.forces),
+                accelerometers: self
+                    .output
+                    .accelerometers
+                    .iter()
+                    .filter_map(|a| {
+                        a.name.strip_prefix(&prefix).map(|n| Accelerometer {
+                            name: n.to_string(),
+                            ..a.clone()
+                        })
+                    })
+                    .collect(),
             },
             output_file: None,
             track: Some(track),
@@ -985,7 +1033,14 @@ impl TrainScenario {
                 });
             }
         }
-        for name in self.output.bodies.iter().chain(&self.output.forces) {
+        let accelerometers = self.output.accelerometers.iter().map(|a| &a.name);
+        for name in self
+            .output
+            .bodies
+            .iter()
+            .chain(&self.output.forces)
+            .chain(accelerometers)
+        {
             if name == "*" {
                 continue;
             }

@@ -84,6 +84,7 @@ fn loads_every_field_and_resolves_paths() {
             velocities: true,
             bodies: vec!["*".into()],
             forces: vec!["k1".into()],
+            accelerometers: vec![],
         }
     );
     assert_eq!(sc.initial.len(), 2);

@@ -138,6 +138,8 @@ pub(crate) struct Columns {
     bodies: Vec<usize>,
     /// (offset into all force outputs, count) of each selected element.
     forces: Vec<(usize, usize)>,
+    /// (body, point in the body's frame) of each accelerometer.
+    accelerometers: Vec<(usize, Vector3<f64>)>,
     need_kinematics: bool,
 }
 
@@ -211,6 +213,19 @@ pub(crate) fn columns(
         offsets.push(offset);
         offset += f.output_names().len();
     }
+    let mut accelerometers = Vec::new();
+    for a in &spec.accelerometers {
+        let b = select(&body_names, std::slice::from_ref(&a.body), "body", file).map_err(|_| {
+            RunError::Setup {
+                file: file.to_path_buf(),
+                message: format!(
+                    "output: accelerometer \"{}\" is on \"{}\", which is no body of the model",
+                    a.name, a.body
+                ),
+            }
+        })?[0];
+        accelerometers.push((b, Vector3::from(a.point)));
+    }
     let mut forces = Vec::new();
     for e in select(&force_names, &spec.forces, "force element", file)? {
         let names = system.forces()[e].output_names();
@@ -219,12 +234,18 @@ pub(crate) fn columns(
         }
         forces.push((offsets[e], names.len()));
     }
+    for a in &spec.accelerometers {
+        for c in ["ax[m/s2]", "ay[m/s2]", "az[m/s2]"] {
+            header.push(format!("{}.{c}", a.name));
+        }
+    }
     Ok(Columns {
         header,
         arc,
         coordinates: spec.coordinates,
         velocities: spec.velocities,
         need_kinematics: !bodies.is_empty() || !forces.is_empty(),
+        accelerometers,
         bodies,
         forces,
     })
@@ -236,12 +257,11 @@ impl Columns {
     pub(crate) fn values(
         &self,
         system: &mut ModelSystem,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
+        row: &Row,
         values: &mut Vec<f64>,
         force_values: &mut Vec<f64>,
     ) -> Result<(), RunError> {
+        let (t, q, v) = (row.t, row.q.as_slice(), row.v.as_slice());
         if self.coordinates {
             values.extend_from_slice(q);
         }
@@ -265,8 +285,54 @@ impl Columns {
             }
             *force_values = all;
         }
+        if !self.accelerometers.is_empty() {
+            accelerations(system, row, &self.accelerometers, values)?;
+        }
         Ok(())
     }
+}
+
+/// Appends the accelerations (m/s², in the body's frame, gravity not
+/// included) of the accelerometer points at an output row. The point's
+/// velocity v_P(t, q, q̇) is differentiated along the motion by a central
+/// difference over (t ± ε, q ± ε q̇, q̇ ± ε q̈): exact for the rheonomic
+/// track-frame inputs as well, O(ε²) truncation, rounding ~1e-16·|v|/ε.
+fn accelerations(
+    system: &mut ModelSystem,
+    row: &Row,
+    points: &[(usize, Vector3<f64>)],
+    values: &mut Vec<f64>,
+) -> Result<(), RunError> {
+    let eps = 1e-5;
+    let shifted = |sign: f64| -> (Vec<f64>, Vec<f64>) {
+        (
+            row.q
+                .iter()
+                .zip(&row.v)
+                .map(|(q, v)| q + sign * eps * v)
+                .collect(),
+            row.v
+                .iter()
+                .zip(&row.a)
+                .map(|(v, a)| v + sign * eps * a)
+                .collect(),
+        )
+    };
+    let mut at = |sign: f64| -> Result<Vec<Vector3<f64>>, RunError> {
+        let (q, v) = shifted(sign);
+        let e = system.evaluate(row.t + sign * eps, &q, &v, Parts::KINEMATICS)?;
+        Ok(points
+            .iter()
+            .map(|(b, p)| e.bodies[*b].point_velocity(p))
+            .collect())
+    };
+    let (plus, minus) = (at(1.0)?, at(-1.0)?);
+    let e = system.evaluate(row.t, &row.q, &row.v, Parts::KINEMATICS)?;
+    for ((b, _), (vp, vm)) in points.iter().zip(plus.iter().zip(&minus)) {
+        let a = e.bodies[*b].rotation.transpose() * ((vp - vm) / (2.0 * eps));
+        values.extend(a.iter());
+    }
+    Ok(())
 }
 
 /// Cardan angles of a rotation matrix for the sequence x, y, z of the moving
@@ -434,6 +500,27 @@ pub(crate) fn check_integrator(system: &ModelSystem, spec: &IntegratorSpec) -> R
     Ok(())
 }
 
+/// Time derivative of [`hermite`] at t.
+pub(crate) fn hermite_derivative(
+    t0: f64,
+    t1: f64,
+    t: f64,
+    y0: f64,
+    d0: f64,
+    y1: f64,
+    d1: f64,
+) -> f64 {
+    let h = t1 - t0;
+    if h <= 0.0 {
+        return d1;
+    }
+    let s = (t - t0) / h;
+    let s2 = s * s;
+    ((6.0 * s2 - 6.0 * s) * y0 + (-6.0 * s2 + 6.0 * s) * y1) / h
+        + (3.0 * s2 - 4.0 * s + 1.0) * d0
+        + (3.0 * s2 - 2.0 * s) * d1
+}
+
 /// Integrator settings of a scenario.
 pub(crate) fn run_integrator<S: crate::system::MechanicalSystem>(
     system: &mut S,
@@ -486,11 +573,11 @@ impl Recorder {
     /// Writes all pending rows. Needs the system for kinematics-based columns.
     pub(crate) fn flush(&mut self, system: &mut ModelSystem) {
         let cols = &self.columns;
-        self.sink.drain(|values, force_values, t, q, v| {
+        self.sink.drain(|values, force_values, row| {
             if let Some(arc) = &cols.arc {
-                values.push(arc_position(arc, t)?);
+                values.push(arc_position(arc, row.t)?);
             }
-            cols.values(system, t, q, v, values, force_values)
+            cols.values(system, row, values, force_values)
         });
     }
 }
@@ -555,15 +642,15 @@ impl CsvSink {
     /// is kept and stops the writing.
     pub(crate) fn drain(
         &mut self,
-        mut fill: impl FnMut(&mut Vec<f64>, &mut Vec<f64>, f64, &[f64], &[f64]) -> Result<(), RunError>,
+        mut fill: impl FnMut(&mut Vec<f64>, &mut Vec<f64>, &Row) -> Result<(), RunError>,
     ) {
-        while let Some((t, q, v)) = self.pending.pop_front() {
+        while let Some(row) = self.pending.pop_front() {
             if self.failure.is_some() {
                 continue;
             }
             self.values.clear();
-            self.values.push(t);
-            let written = fill(&mut self.values, &mut self.force_values, t, &q, &v)
+            self.values.push(row.t);
+            let written = fill(&mut self.values, &mut self.force_values, &row)
                 .and_then(|()| write_row_text(&mut self.writer, &mut self.line, &self.values));
             match written {
                 Ok(()) => self.rows += 1,
@@ -672,8 +759,16 @@ pub(crate) struct OutputSchedule {
     calls: u64,
 }
 
-/// Rows waiting to be written: (t, q, q̇).
-pub(crate) type PendingRows = std::collections::VecDeque<(f64, Vec<f64>, Vec<f64>)>;
+/// An output row's state: time (s), q, q̇ and q̈ (interpolated).
+pub(crate) struct Row {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+}
+
+/// Rows waiting to be written.
+pub(crate) type PendingRows = std::collections::VecDeque<Row>;
 
 impl OutputSchedule {
     pub(crate) fn new(t_end: f64, interval: f64, n: usize) -> Self {
@@ -710,18 +805,29 @@ impl OutputSchedule {
             if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
                 break;
             }
-            let (qi, vi) = match &self.prev {
-                Some((t0, q0, v0, a0)) if to < t => (
-                    (0..n)
+            let row = match &self.prev {
+                Some((t0, q0, v0, a0)) if to < t => Row {
+                    t: to,
+                    q: (0..n)
                         .map(|i| hermite(*t0, t, to, q0[i], v0[i], q[i], v[i]))
                         .collect(),
-                    (0..n)
+                    v: (0..n)
                         .map(|i| hermite(*t0, t, to, v0[i], a0[i], v[i], a[i]))
                         .collect(),
-                ),
-                _ => (q.to_vec(), v.to_vec()),
+                    // The derivative of the velocity interpolant, so that
+                    // q̈ is consistent with the q̇ written.
+                    a: (0..n)
+                        .map(|i| hermite_derivative(*t0, t, to, v0[i], a0[i], v[i], a[i]))
+                        .collect(),
+                },
+                _ => Row {
+                    t: to,
+                    q: q.to_vec(),
+                    v: v.to_vec(),
+                    a: a.to_vec(),
+                },
             };
-            pending.push_back((to, qi, vi));
+            pending.push_back(row);
             self.next_row += 1;
             if is_last {
                 break;

@@ -24,7 +24,7 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, check_integrator,
+    Columns, CsvSink, OutputSchedule, Row, RunError, RunSummary, arc_position, check_integrator,
     columns, continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
@@ -450,22 +450,21 @@ struct TrainRecorder {
 impl TrainRecorder {
     fn flush(&mut self, train: &mut TrainSystem) {
         let (arc, columns) = (&self.arc, &self.columns);
-        self.sink.drain(|values, force_values, t, q, v| {
+        self.sink.drain(|values, force_values, row| {
             if let Some((arc, offset)) = arc {
-                values.push(arc_position(arc, t)? - offset);
+                values.push(arc_position(arc, row.t)? - offset);
             }
             for (k, cols) in columns.iter().enumerate() {
                 let r = train.range(k);
-                cols.values(
-                    train.vehicle_mut(k),
-                    t,
-                    &q[r.clone()],
-                    &v[r],
-                    values,
-                    force_values,
-                )?;
+                let vehicle_row = Row {
+                    t: row.t,
+                    q: row.q[r.clone()].to_vec(),
+                    v: row.v[r.clone()].to_vec(),
+                    a: row.a[r].to_vec(),
+                };
+                cols.values(train.vehicle_mut(k), &vehicle_row, values, force_values)?;
             }
-            Ok(train.coupler_outputs(t, q, v, values)?)
+            Ok(train.coupler_outputs(row.t, &row.q, &row.v, values)?)
         });
     }
 }
