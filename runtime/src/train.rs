@@ -314,7 +314,8 @@ impl MechanicalSystem for TrainSystem {
                 ];
                 let gamma = &self.vehicles[k].last_evaluation().jacobians;
                 let r = self.ranges[k].clone();
-                for (col, qi) in r.enumerate() {
+                // Element states (after the coordinates) take no coupler force.
+                for (col, qi) in r.take(gamma.ncols()).enumerate() {
                     let mut s = 0.0;
                     for (row, x) in comps.iter().enumerate() {
                         s += gamma[(6 * b + row, col)] * x;
@@ -389,7 +390,8 @@ impl MechanicalSystem for TrainSystem {
             for (i, range) in ranges.iter().enumerate() {
                 let src = &self.vehicles[c.vehicles[i]].last_evaluation().jacobians;
                 let col0 = if i == 0 { 0 } else { n1 };
-                let n = range.len();
+                // The coordinates' columns; element states after them stay zero.
+                let n = range.len().min(src.ncols());
                 gamma
                     .view_mut((6 * i, col0), (6, n))
                     .copy_from(&src.view((6 * c.bodies[i], 0), (6, n)));
