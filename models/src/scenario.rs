@@ -586,6 +586,13 @@ pub struct TrainCoupler {
     /// Constant force F₀, N (positive x: body 2 pushed backwards, i.e. a
     /// compressed coupler between a leading body 1 and a trailing body 2).
     pub preload: [f64; 3],
+    /// Nonlinear longitudinal characteristic replacing `stiffness.x`: rows
+    /// (δx m, force N), δx the displacement of point 2 from point 1 along
+    /// body 1's x axis, body 2 receiving −f along that axis. With body 1
+    /// leading and body 2 trailing, δx > 0 compresses the buffers and δx < 0
+    /// pulls the draw gear; slack is a range of zero force. The damping along
+    /// x stays linear.
+    pub longitudinal: Option<(Vec<(f64, f64)>, crate::Interpolation)>,
 }
 
 /// One vehicle of a train: a model file at an arc offset from the train's
@@ -688,6 +695,10 @@ struct RawCoupler {
     angular_damping: (f64, f64, f64),
     #[serde(default)]
     preload: (f64, f64, f64),
+    #[serde(default, deserialize_with = "some")]
+    longitudinal: Option<Vec<(f64, f64)>>,
+    #[serde(default)]
+    interpolation: crate::Interpolation,
 }
 
 /// The constructor name of the file's top-level value (`Scenario`, `Train`),
@@ -904,6 +915,20 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
                 "points, stiffness, damping and preload must be finite".into(),
             ));
         }
+        if let Some(rows) = &c.longitudinal
+            && (rows.len() < 2
+                || rows.windows(2).any(|w| !(w[1].0 > w[0].0))
+                || rows.iter().any(|(x, f)| !(x.is_finite() && f.is_finite())))
+        {
+            problems.push((
+                "longitudinal".into(),
+                Some(c.name.clone()),
+                element.clone(),
+                "the longitudinal characteristic needs at least 2 finite rows (extension m, \
+                 force N) with increasing extensions"
+                    .into(),
+            ));
+        }
         if let (Some((k1, b1)), Some((k2, b2))) = (s1, s2) {
             if k1 == k2 {
                 problems.push((
@@ -928,6 +953,7 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
                 angular_stiffness: v3(c.angular_stiffness),
                 angular_damping: v3(c.angular_damping),
                 preload: v3(c.preload),
+                longitudinal: c.longitudinal.map(|rows| (rows, c.interpolation)),
             });
         }
     }

@@ -20,7 +20,8 @@
 
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
-    Assessment, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
+    Assessment, Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch,
+    Linear6, Wrench,
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
@@ -77,6 +78,12 @@ impl Coupler {
         };
         let mut element = Linear6::new(spec.name.clone(), &kind);
         element.set_parameters(&[])?;
+        if let Some((rows, interpolation)) = &spec.longitudinal {
+            let f = Characteristic::new(rows, *interpolation).map_err(|e| {
+                SimError::Other(format!("coupler \"{}\": longitudinal: {e}", spec.name))
+            })?;
+            element = element.with_longitudinal(f);
+        }
         Ok(Self {
             name: spec.name.clone(),
             vehicles: [spec.vehicle1, spec.vehicle2],

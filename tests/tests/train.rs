@@ -241,6 +241,67 @@ fn a_vehicle_with_element_states_couples_and_conserves_momentum() {
     }
 }
 
+/// A coupler with slack and buffers (`longitudinal` characteristic): the
+/// trailing car closing on the leading one at 1 m/s meets no force for the
+/// 0.05 m of slack, then the 1e6 N/m buffers act for half a period of the
+/// two-mass oscillator, π√(μ/k) with μ = m/2, and the equal cars exchange
+/// their velocities (no damping: an elastic impact). They then drift apart
+/// through the slack; the draw gear would engage 0.1 s later, after the run.
+#[test]
+fn coupler_slack_and_buffers_give_an_elastic_impact() {
+    let dir = tempfile::tempdir().unwrap();
+    let train = train_from_text(
+        dir.path(),
+        &format!(
+            r#"Train(
+            vehicles: [
+                Vehicle(name: "A", model: "{car}", offset: 0.0),
+                Vehicle(name: "B", model: "{car}", offset: -10.0,
+                        initial: [(coord: "body.x", velocity: 1.0)]),
+            ],
+            couplers: [
+                Coupler(name: "AB", body1: "A.body", point1: (-5.0, 0.0, 0.0),
+                        body2: "B.body", point2: (5.0, 0.0, 0.0),
+                        stiffness: (0.0, 2e4, 3e4),
+                        longitudinal: [(-0.15, -1e5), (-0.05, 0.0), (0.05, 0.0), (0.15, 1e5)]),
+            ],
+            track: (file: "{track}", start: 100.0, speed: 10.0),
+            end_time: 0.2,
+            integrator: Park(rtol: 1e-9, atol: 1e-10, max_step: 0.001),
+            output: (interval: 0.001, bodies: ["*"], forces: []),
+        )"#,
+            car = path_text("vehicles/train/track_car.ron"),
+            track = path_text("tracks/straight.ron"),
+        ),
+    );
+    let (t, _) = run(&train, numeric, &dir.path().join("out.csv"));
+    let (time, fx) = (t.col("time"), t.col("AB.Fx[N]"));
+    let (va, vb) = (t.col("A.body.vx[m/s]"), t.col("B.body.vx[m/s]"));
+    let omega = (1e6f64 / 500.0).sqrt();
+    let (t_touch, t_leave) = (0.05, 0.05 + std::f64::consts::PI / omega);
+    for i in 0..time.len() {
+        if time[i] < t_touch - 1e-3 || time[i] > t_leave + 1e-3 {
+            assert!(fx[i].abs() < 1e-6, "force {} N at t = {}", fx[i], time[i]);
+        }
+    }
+    // Peak buffer force k·v/ω = 1e6·1/44.7 N, on body 2 pushing it back.
+    let peak = fx.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+    assert!(
+        (peak - 1e6 / omega).abs() < 2e-3 * 1e6 / omega,
+        "peak {peak} N"
+    );
+    // Velocities exchanged (absolute, the frames move at 10 m/s); Park at
+    // rtol 1e-9 with the kinks at touch-down and lift-off falling inside
+    // steps of ≤ 1 ms: 1e-3 m/s.
+    let last = time.len() - 1;
+    assert!(
+        (va[last] - 11.0).abs() < 1e-3 && (vb[last] - 10.0).abs() < 1e-3,
+        "{} {}",
+        va[last],
+        vb[last]
+    );
+}
+
 /// Three coaches from the bundled train file, numeric engine.
 fn train3(end_time: f64) -> TrainScenario {
     let mut train =

@@ -1,8 +1,8 @@
 //! Generalized linear 6×6 elastic and dissipative element (seed paper Sect. 3.2).
 
 use super::{
-    ForceContext, ForceElement, ForceJacobian, FrameAttachment, Wrench, add_force, add_moment,
-    eval_scalar,
+    Characteristic, ForceContext, ForceElement, ForceJacobian, FrameAttachment, Wrench, add_force,
+    add_moment, eval_scalar,
 };
 use crate::system::SimError;
 use nalgebra::{Matrix6, Vector3, Vector6};
@@ -26,6 +26,9 @@ pub struct Linear6 {
     pub stiffness: Matrix6<f64>,
     pub damping: Matrix6<f64>,
     pub preload: Vector6<f64>,
+    /// Nonlinear characteristic f(δx) replacing the stiffness term C₀₀ δx
+    /// of the x force (a coupler's draw gear and buffers).
+    longitudinal: Option<Characteristic>,
 }
 
 impl Linear6 {
@@ -55,7 +58,24 @@ impl Linear6 {
             stiffness: Matrix6::zeros(),
             damping: Matrix6::zeros(),
             preload: Vector6::zeros(),
+            longitudinal: None,
         }
+    }
+
+    /// Replaces the stiffness term C₀₀ δx of the x force by f(δx).
+    pub fn with_longitudinal(mut self, f: Characteristic) -> Self {
+        self.longitudinal = Some(f);
+        self
+    }
+
+    /// The stiffness matrix at deflection δ: C, with C₀₀ = f′(δx) when the x
+    /// characteristic is nonlinear.
+    fn tangent_stiffness(&self, x: &Vector6<f64>) -> Matrix6<f64> {
+        let mut c = self.stiffness;
+        if let Some(f) = &self.longitudinal {
+            c[(0, 0)] = f.eval(x[0]).1;
+        }
+        c
     }
 
     /// Relative displacement and its rate, in frame 1.
@@ -86,7 +106,11 @@ impl Linear6 {
 
     fn wrench_in_frame1(&self, ctx: &ForceContext) -> Vector6<f64> {
         let (x, xd) = self.deflection(ctx);
-        -(self.stiffness * x + self.damping * xd + self.preload)
+        let mut elastic = self.stiffness * x;
+        if let Some(f) = &self.longitudinal {
+            elastic[0] += f.eval(x[0]).0 - self.stiffness[(0, 0)] * x[0];
+        }
+        -(elastic + self.damping * xd + self.preload)
     }
 }
 
@@ -136,17 +160,23 @@ impl ForceElement for Linear6 {
         out.extend(self.wrench_in_frame1(ctx).iter());
     }
 
-    /// W = −(C δ + D δ̇ + W₀): ∂W/∂δ = −C, ∂W/∂δ̇ = −D, mapped by the relative
-    /// motion Jacobian of the frames (exact at zero deflection and rate).
+    /// W = −(C δ + D δ̇ + W₀): ∂W/∂δ = −C (with C₀₀ = f′(δx) for a nonlinear
+    /// x characteristic), ∂W/∂δ̇ = −D, mapped by the relative motion Jacobian
+    /// of the frames (exact at zero deflection and rate).
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
         let p2 = self.frames[1].point.position(ctx);
         let (a1, _) = self.frames[0].orientation(ctx);
+        let c = if self.longitudinal.is_some() {
+            self.tangent_stiffness(&self.deflection(ctx).0)
+        } else {
+            self.stiffness
+        };
         jac.add_frame_pair(
             self.frames[0].point.body,
             self.frames[1].point.body,
             &p2,
             &a1,
-            &(-self.stiffness),
+            &(-c),
             &(-self.damping),
         );
         Ok(())

@@ -17,7 +17,7 @@ pub use applied::AppliedForce;
 pub use bipolar::LinearBipolar;
 pub use contact::{PointPlane, contact_stiffness_damping};
 pub use linear6::Linear6;
-pub use nonlinear::{CoulombFriction, LoadFriction, Tabulated};
+pub use nonlinear::{Characteristic, CoulombFriction, LoadFriction, Tabulated};
 pub use series::SeriesSpringDamper;
 pub use wheel_rail::{TrackBinding, WheelRailContact};
 

@@ -438,17 +438,13 @@ impl ForceElement for LoadFriction {
 // Tabulated characteristic
 // ---------------------------------------------------------------------------
 
-/// Tabulated force–deflection characteristic: F = f(x − x0) + d ẋ with f
-/// piecewise linear through the table rows, extended linearly beyond the
-/// first and last rows (a bump stop keeps its end stiffness). Positive F pulls
-/// the points together.
-#[derive(Debug, Clone)]
-pub struct Tabulated {
-    name: String,
-    pair: TwoPoint,
-    table_expr: Vec<(Expr, Expr)>,
-    damping_expr: Expr,
-    x0_expr: Expr,
+/// A force–deflection characteristic f(u) through table rows (deflections
+/// increasing), interpolated straight or by a monotone cubic, and extended
+/// beyond the end rows with the end slope (a bump stop keeps its end
+/// stiffness). Shared by [`Tabulated`] and the nonlinear longitudinal
+/// characteristic of couplers.
+#[derive(Debug, Clone, Default)]
+pub struct Characteristic {
     interpolation: Interpolation,
     /// Deflections, m (increasing).
     pub deflections: Vec<f64>,
@@ -456,45 +452,35 @@ pub struct Tabulated {
     pub forces: Vec<f64>,
     /// Slopes at the rows (N/m) of the cubic interpolation.
     slopes: Vec<f64>,
-    /// N s/m.
-    pub damping: f64,
-    /// m.
-    pub free_length: f64,
 }
 
-impl Tabulated {
-    /// From a model's `ForceKind::Tabulated`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Tabulated {
-            body1,
-            point1,
-            body2,
-            point2,
-            table,
-            interpolation,
-            damping,
-            free_length,
-        } = kind
-        else {
-            unreachable!("Tabulated::new takes a Tabulated element")
-        };
-        Self {
-            name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
-            table_expr: table.clone(),
-            damping_expr: damping.clone(),
-            x0_expr: free_length.clone(),
-            interpolation: *interpolation,
-            deflections: Vec::new(),
-            forces: Vec::new(),
-            slopes: Vec::new(),
-            damping: 0.0,
-            free_length: 0.0,
+impl Characteristic {
+    /// Through the rows `(deflection m, force N)`; at least two rows with
+    /// increasing, finite deflections and finite forces, or an error saying
+    /// what is wrong.
+    pub fn new(rows: &[(f64, f64)], interpolation: Interpolation) -> Result<Self, String> {
+        if rows.len() < 2
+            || rows.windows(2).any(|w| !(w[1].0 > w[0].0))
+            || rows.iter().any(|(x, f)| !(x.is_finite() && f.is_finite()))
+        {
+            return Err(format!(
+                "the table needs at least 2 finite rows with increasing deflections, got {rows:?}"
+            ));
         }
+        let mut c = Self {
+            interpolation,
+            deflections: rows.iter().map(|r| r.0).collect(),
+            forces: rows.iter().map(|r| r.1).collect(),
+            slopes: Vec::new(),
+        };
+        if interpolation == Interpolation::Spline {
+            c.monotone_slopes();
+        }
+        Ok(c)
     }
 
-    /// Table value f(u) (N) and slope (N/m) at deflection u (m).
-    pub fn characteristic(&self, u: f64) -> (f64, f64) {
+    /// Value f(u) (N) and slope (N/m) at deflection u (m).
+    pub fn eval(&self, u: f64) -> (f64, f64) {
         let xs = &self.deflections;
         let fs = &self.forces;
         // Segment k spans xs[k]..xs[k+1]; the end segments extend outwards.
@@ -534,10 +520,10 @@ impl Tabulated {
         (f, df)
     }
 
-    /// Fritsch–Carlson slopes: the harmonic-type three-point estimate inside
-    /// (zero where the secants change sign or one vanishes), one-sided at the
-    /// ends, then limited so that α² + β² ≤ 9 on every segment (α, β the end
-    /// slopes over the secant), which keeps each segment monotone.
+    /// Fritsch–Carlson slopes: the three-point average inside (zero where the
+    /// secants change sign or one vanishes), one-sided at the ends, then
+    /// limited so that α² + β² ≤ 9 on every segment (α, β the end slopes over
+    /// the secant), which keeps each segment monotone.
     fn monotone_slopes(&mut self) {
         let (xs, fs) = (&self.deflections, &self.forces);
         let n = xs.len();
@@ -570,6 +556,61 @@ impl Tabulated {
     }
 }
 
+/// Tabulated force–deflection characteristic: F = f(x − x0) + d ẋ with f
+/// through the table rows ([`Characteristic`]: straight lines or a monotone
+/// cubic between them, extended linearly beyond the first and last rows).
+/// Positive F pulls the points together.
+#[derive(Debug, Clone)]
+pub struct Tabulated {
+    name: String,
+    pair: TwoPoint,
+    table_expr: Vec<(Expr, Expr)>,
+    damping_expr: Expr,
+    x0_expr: Expr,
+    interpolation: Interpolation,
+    /// The characteristic f with the current parameters.
+    pub characteristic: Characteristic,
+    /// N s/m.
+    pub damping: f64,
+    /// m.
+    pub free_length: f64,
+}
+
+impl Tabulated {
+    /// From a model's `ForceKind::Tabulated`.
+    pub fn new(name: String, kind: &ForceKind) -> Self {
+        let ForceKind::Tabulated {
+            body1,
+            point1,
+            body2,
+            point2,
+            table,
+            interpolation,
+            damping,
+            free_length,
+        } = kind
+        else {
+            unreachable!("Tabulated::new takes a Tabulated element")
+        };
+        Self {
+            name,
+            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            table_expr: table.clone(),
+            damping_expr: damping.clone(),
+            x0_expr: free_length.clone(),
+            interpolation: *interpolation,
+            characteristic: Characteristic::default(),
+            damping: 0.0,
+            free_length: 0.0,
+        }
+    }
+
+    /// Table value f(u) (N) and slope (N/m) at deflection u (m).
+    pub fn characteristic(&self, u: f64) -> (f64, f64) {
+        self.characteristic.eval(u)
+    }
+}
+
 impl ForceElement for Tabulated {
     fn name(&self) -> &str {
         &self.name
@@ -577,33 +618,17 @@ impl ForceElement for Tabulated {
 
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
         self.pair.set_parameters(params, &self.name)?;
-        self.deflections.clear();
-        self.forces.clear();
+        let mut rows = Vec::with_capacity(self.table_expr.len());
         for (k, (x, f)) in self.table_expr.iter().enumerate() {
-            self.deflections.push(eval_scalar(
-                x,
-                params,
-                &self.name,
-                &format!("table[{k}].deflection"),
-            )?);
-            self.forces.push(eval_scalar(
-                f,
-                params,
-                &self.name,
-                &format!("table[{k}].force"),
-            )?);
+            rows.push((
+                eval_scalar(x, params, &self.name, &format!("table[{k}].deflection"))?,
+                eval_scalar(f, params, &self.name, &format!("table[{k}].force"))?,
+            ));
         }
-        if self.deflections.len() < 2 || self.deflections.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(SimError::Other(format!(
-                "force element \"{}\": the table needs at least 2 rows with increasing deflections, got {:?}",
-                self.name, self.deflections
-            )));
-        }
+        self.characteristic = Characteristic::new(&rows, self.interpolation)
+            .map_err(|e| SimError::Other(format!("force element \"{}\": {e}", self.name)))?;
         self.damping = eval_scalar(&self.damping_expr, params, &self.name, "damping d")?;
         self.free_length = eval_scalar(&self.x0_expr, params, &self.name, "free length x0")?;
-        if self.interpolation == Interpolation::Spline {
-            self.monotone_slopes();
-        }
         Ok(())
     }
 
