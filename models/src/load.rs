@@ -2071,6 +2071,7 @@ impl Cx<'_> {
                     creep,
                     rail,
                     table,
+                    wheels,
                     ..
                 } => self.wheel_rail(
                     &w,
@@ -2096,6 +2097,7 @@ impl Cx<'_> {
                         creep,
                         rail,
                         table,
+                        wheels: wheels.as_ref(),
                     },
                 ),
                 RawForce::Applied {
@@ -2258,6 +2260,8 @@ struct WheelRailRaw<'r> {
     creep: &'r RawCreepLaw,
     rail: &'r RawRail,
     table: &'r RawTable,
+    /// Independently rotating wheels' bodies (left, right), if any.
+    wheels: Option<&'r (String, String)>,
 }
 
 impl Cx<'_> {
@@ -2386,6 +2390,39 @@ impl Cx<'_> {
                 );
             }
         }
+        let wheels = raw.wheels.map(|(left, right)| {
+            let mut ids = [0; 2];
+            for (k, name) in [left, right].into_iter().enumerate() {
+                ids[k] = match self.body_ref(w, "wheels", name, lookup) {
+                    BodyRef::Body(b) => b,
+                    BodyRef::Ground => {
+                        if name == "ground" {
+                            self.err(
+                                w,
+                                Some("wheels"),
+                                Some(name),
+                                "a wheel must be a body, not ground".into(),
+                            );
+                        }
+                        0
+                    }
+                };
+            }
+            if ids[0] == ids[1] || ids.contains(&wheelset) {
+                self.err(
+                    w,
+                    Some("wheels"),
+                    None,
+                    format!(
+                        "the two wheels (\"{left}\", \"{right}\") must be two different bodies, \
+                         neither of them the wheelset \"{}\" (that is a solid wheelset: omit \
+                         `wheels`)",
+                        raw.wheelset
+                    ),
+                );
+            }
+            ids
+        });
         let mut e = e.into_iter();
         let mut next = || e.next().expect("seven values");
         ForceKind::WheelRail(Box::new(WheelRail {
@@ -2408,6 +2445,7 @@ impl Cx<'_> {
                 roll_max: t.roll_max,
                 droll: t.droll,
             },
+            wheels,
         }))
     }
 }

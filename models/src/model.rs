@@ -361,6 +361,13 @@ pub struct WheelRail {
     pub rail: RailKind,
     /// Contact table ranges and steps.
     pub table: ContactTableSpec,
+    /// Independently rotating wheels: the bodies (left, right) that carry
+    /// each wheel's spin, usually on revolute joints about the axle's y axis.
+    /// Each wheel's contact forces act on its own body and its creepages come
+    /// from that body's velocity and angular velocity; the contact geometry
+    /// still follows the `wheelset` (axle) body's pose. `None`: a solid
+    /// wheelset, both wheels on the `wheelset` body.
+    pub wheels: Option<[usize; 2]>,
 }
 
 /// Creep-force law of a wheel–rail element.

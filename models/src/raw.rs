@@ -601,6 +601,10 @@ pub(crate) enum RawForce {
         rail: RawRail,
         #[serde(default)]
         table: RawTable,
+        /// Independently rotating wheels: the bodies (left, right) carrying
+        /// each wheel's spin; `None` for a solid wheelset.
+        #[serde(default)]
+        wheels: Option<(String, String)>,
     },
     Applied {
         name: String,

@@ -219,7 +219,12 @@ impl ForceKind {
                 body_ref(body, f);
                 body_ref(plane_body, f);
             }
-            ForceKind::WheelRail(w) => f(&mut w.wheelset),
+            ForceKind::WheelRail(w) => {
+                f(&mut w.wheelset);
+                if let Some(wheels) = &mut w.wheels {
+                    wheels.iter_mut().for_each(&mut *f);
+                }
+            }
             ForceKind::Applied { body, .. } => f(body),
         }
     }

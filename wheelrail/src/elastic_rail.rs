@@ -30,6 +30,18 @@
 //!   creepage), and the inner problem is solved again, until the normal and
 //!   creep forces change by less than the tolerance.
 //!
+//! With damping over a finite step the rail's velocity `(d − d_prev)/h` makes
+//! the lateral creep force a damper on the rail, of rate `f₂₂/V` (N·s/m, f₂₂
+//! Kalker's lateral creep coefficient): frozen during the inner iterations,
+//! the outer iterations diverge as soon as `f₂₂/(V h)` exceeds the support's
+//! `k_y + c_y/h` (e.g. 300 kN·s/m of creep damping at 30 m/s against 100
+//! kN·s/m of rail damping). So the inner iterations carry the creep force to
+//! first order in `d`: `Tᵢ(d) ≈ Tᵢ(d_k) + gᵢ tᵢ·(d − d_k)`, `gᵢ = f₂₂,ᵢ/(V h)`
+//! from Kalker's coefficient (scaled by the saturation |F|/|F_linear| of the
+//! law's actual force), `d_k` the displacement of the last outer iteration.
+//! The converged solution is the same (the outer iterations stop when the
+//! creep forces at `d` no longer change); only the convergence is helped.
+//!
 //! The contact geometry is supplied through [`RailContactGeometry`] — "the
 //! contact geometry at a given rail displacement": [`ProfileRailContacts`]
 //! implements it from the wheel and rail profiles ([`crate::geometry`], one- and
@@ -39,6 +51,7 @@
 use crate::creep::{ContactPatch, CreepForces, CreepLaw, Creepages};
 use crate::geometry::{Contact, ContactGeometry};
 use crate::hertz::HertzShape;
+use crate::kalker::KalkerCoefficients;
 
 /// Most contacts per wheel (tread and flange).
 pub const MAX_CONTACTS: usize = 2;
@@ -356,8 +369,11 @@ pub fn solve(
         })?,
         creepages: Creepages::default(),
     }; MAX_CONTACTS];
-    // Lateral creep forces (along tᵢ) held fixed in the inner iterations.
+    // Lateral creep forces (along tᵢ) in the inner iterations, to first order
+    // in the rail displacement about `d_lin`: creep_t + creep_g·tᵢ·(d − d_lin).
     let mut creep_t = [0.0; MAX_CONTACTS];
+    let mut creep_g = [0.0; MAX_CONTACTS];
+    let mut d_lin = d_prev;
     let mut creep = [CreepForces::default(); MAX_CONTACTS];
     let mut normal = [0.0; MAX_CONTACTS];
     let mut inner_total = 0;
@@ -381,13 +397,15 @@ pub fn solve(
                 let [ny, nz] = c.normal;
                 let t = [nz, -ny];
                 normal[i] = nn;
-                r[0] += nn * ny + creep_t[i] * t[0];
-                r[1] += nn * nz + creep_t[i] * t[1];
-                // dFᵢ/dd = kn·n nᵀ (δ = δ₀ + n·d).
-                j[0][0] += kn * ny * ny;
-                j[0][1] += kn * ny * nz;
-                j[1][0] += kn * nz * ny;
-                j[1][1] += kn * nz * nz;
+                let ti = linear_creep(creep_t[i], creep_g[i], t, d, d_lin);
+                r[0] += nn * ny + ti * t[0];
+                r[1] += nn * nz + ti * t[1];
+                // dFᵢ/dd = kn·n nᵀ (δ = δ₀ + n·d) + gᵢ t tᵀ.
+                let g = creep_g[i];
+                j[0][0] += kn * ny * ny + g * t[0] * t[0];
+                j[0][1] += kn * ny * nz + g * t[0] * t[1];
+                j[1][0] += kn * nz * ny + g * t[1] * t[0];
+                j[1][1] += kn * nz * nz + g * t[1] * t[1];
             }
             residual = r[0].hypot(r[1]);
             if residual <= settings.force_tol {
@@ -406,7 +424,14 @@ pub fn solve(
             let mut accepted = false;
             for _ in 0..30 {
                 let trial = [d[0] + dd[0], d[1] + dd[1]];
-                let rt = residual_at(geometry, &mut geo, trial, keff, rhs0, &creep_t)?;
+                let rt = residual_at(
+                    geometry,
+                    &mut geo,
+                    trial,
+                    keff,
+                    rhs0,
+                    (&creep_t, &creep_g, d_lin),
+                )?;
                 if rt < r_norm || rt <= settings.force_tol {
                     d = trial;
                     accepted = true;
@@ -438,7 +463,14 @@ pub fn solve(
             scale = scale.max(normal[i]);
             creep[i] = f;
             creep_t[i] = f.fy;
+            creep_g[i] = if settings.h.is_finite() && normal[i] > 0.0 {
+                lateral_creep_coefficient(c, normal[i], material, vel, t, settings.v_roll, &f)
+                    / (settings.v_roll * settings.h)
+            } else {
+                0.0
+            };
         }
+        d_lin = d;
         for item in creep.iter_mut().skip(n_contacts) {
             *item = CreepForces::default();
         }
@@ -553,15 +585,54 @@ fn creep_force(
     Ok((f, hc.a))
 }
 
-/// Norm of the inner residual at displacement `d`.
+/// The lateral creep force of a contact at rail displacement `d`, to first
+/// order about `d_lin` where it is `t0` with slope `g` along `t`.
+fn linear_creep(t0: f64, g: f64, t: [f64; 2], d: [f64; 2], d_lin: [f64; 2]) -> f64 {
+    t0 + g * (t[0] * (d[0] - d_lin[0]) + t[1] * (d[1] - d_lin[1]))
+}
+
+/// −∂T/∂η (N) of a contact's lateral creep force: Kalker's f₂₂ = G a b C₂₂
+/// scaled by the saturation |F|/|F_linear| (≤ 1) of the law's force `f`;
+/// 0 where Kalker's table does not apply.
+fn lateral_creep_coefficient(
+    c: &RailContact,
+    nn: f64,
+    material: &ContactMaterial,
+    vel: [f64; 2],
+    t: [f64; 2],
+    v_roll: f64,
+    f: &CreepForces,
+) -> f64 {
+    let Ok(hc) = c.hertz.contact(nn) else {
+        return 0.0;
+    };
+    let Some(k) = KalkerCoefficients::interpolate_ab(hc.a, hc.b, material.nu) else {
+        return 0.0;
+    };
+    let gab = material.g * hc.a * hc.b;
+    let (f11, f22) = (gab * k.c11, gab * k.c22);
+    let eta = c.creepages.eta - (vel[0] * t[0] + vel[1] * t[1]) / v_roll;
+    let linear = (f11 * c.creepages.xi).hypot(f22 * eta);
+    let actual = f.fx.hypot(f.fy);
+    let ratio = if linear > 0.0 {
+        (actual / linear).min(1.0)
+    } else {
+        1.0
+    };
+    f22 * ratio
+}
+
+/// Norm of the inner residual at displacement `d`; `creep` holds the lateral
+/// creep forces, their slopes and the displacement they are linearised about.
 fn residual_at(
     geometry: &dyn RailContactGeometry,
     geo: &mut [RailContact; MAX_CONTACTS],
     d: [f64; 2],
     keff: [f64; 2],
     rhs0: [f64; 2],
-    creep_t: &[f64; MAX_CONTACTS],
+    creep: (&[f64; MAX_CONTACTS], &[f64; MAX_CONTACTS], [f64; 2]),
 ) -> Result<f64, ElasticRailError> {
+    let (creep_t, creep_g, d_lin) = creep;
     let n = geometry.contacts_at(d, geo)?;
     let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
     for (i, c) in geo[..n].iter().enumerate() {
@@ -571,8 +642,9 @@ fn residual_at(
             .normal_force(c.approach)
             .map_err(|e| contact_err(i, e))?;
         let [ny, nz] = c.normal;
-        r[0] += nn * ny + creep_t[i] * nz;
-        r[1] += nn * nz - creep_t[i] * ny;
+        let ti = linear_creep(creep_t[i], creep_g[i], [nz, -ny], d, d_lin);
+        r[0] += nn * ny + ti * nz;
+        r[1] += nn * nz - ti * ny;
     }
     Ok(r[0].hypot(r[1]))
 }

@@ -29,6 +29,33 @@
 //! 5. the Hertz ellipse and the creep forces by the chosen law; on the wheel:
 //!    N n + Fx eₓ + Fy eᵧ at the contact point and the spin moment Mz n.
 //!
+//! **Elastic rails** (`rail: Elastic(ky, cy, kz, cz)`, seed paper Sect. 4.2):
+//! each rail head is massless and moves laterally and vertically, by
+//! d = (d_y, d_z) in the track's cross-section, against a spring–damper to
+//! ground. At every force evaluation and for each rail,
+//! [`railmbs_wheelrail::elastic_rail::solve`] finds d in equilibrium with
+//! that wheel's contacts (inner Newton iterations on d for the normal forces,
+//! outer iterations for the creep forces; one- and two-point contact): the
+//! contacts come from the same table with the wheelset shifted by −d_y over
+//! the rail and the gap closed by d_z, and the rail's velocity enters the
+//! lateral creepage. The damper's rate is backward Euler,
+//! ḋ = (d − d_prev)/(t − t_prev), from the rail displacement d_prev of the
+//! latest accepted step before t (the element's state, changed only in
+//! [`ForceElement::accept_step`], never inside Newton iterations or by
+//! rejected steps); without an accepted step before t (the start of a run)
+//! the rails are in static equilibrium. The contact has no damper of its own
+//! along the normal then (`normal_damping` must be 0: the rail dampers act
+//! in series with the Hertz spring). The Jacobian uses the Hertz stiffness in
+//! series with the support's K + C/h along the normal. Outputs per rail:
+//! `L.rail_dy`, `L.rail_dz` (m, track frame, +y left, +z up).
+//!
+//! **Independently rotating wheels** (`wheels: Some(("WheelL", "WheelR"))`):
+//! each wheel is its own body turning on the axle (the `wheelset` body, which
+//! then has no spin). The contact geometry still follows the axle's pose;
+//! each wheel's contact forces act on its own body and its creepages come
+//! from that body's velocity and angular velocity, so each wheel rolls at its
+//! own speed and no longitudinal creep couples the two.
+//!
 //! The rails' reactions go to ground (the track is not a body of the model).
 //! Outputs per wheel follow the usual assessment conventions: Q the vertical
 //! wheel load and Y the lateral force of the wheel on the rail, positive
@@ -46,6 +73,10 @@ use railmbs_models::{CreepLawKind, RailKind, WheelRail};
 use railmbs_track::{SpeedLaw, Track};
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+};
+use railmbs_wheelrail::elastic_rail::{
+    self, ContactMaterial, ElasticRailError, ElasticRailSettings, RailContact, RailContactGeometry,
+    RailSupport,
 };
 use railmbs_wheelrail::geometry::{self, Contact, ContactTable, SearchSettings, TableSettings};
 use railmbs_wheelrail::hertz::{HertzShape, effective_modulus, wheel_rail_curvatures};
@@ -74,6 +105,9 @@ fn smoothstep(x: f64) -> f64 {
     let x = x.clamp(0.0, 1.0);
     x * x * (3.0 - 2.0 * x)
 }
+
+/// Accepted steps whose elastic-rail displacements are kept.
+const RAIL_HISTORY: usize = 4;
 
 /// Largest tan δ used for the contact's lead ahead of the axle plane (75°).
 const MAX_LEAD_TAN: f64 = 3.73;
@@ -117,6 +151,8 @@ struct Constants {
     normal_damping: f64,
     /// Mueller exponent.
     exponent: f64,
+    /// Elastic rails' support (per rail), or `None` for rigid rails.
+    rail: Option<RailSupport>,
 }
 
 /// Where the element is on the track (after [`ForceElement::bind_track`]).
@@ -155,6 +191,8 @@ struct ContactState {
     /// frame, m).
     angle: f64,
     rail_y: f64,
+    /// Rolling radius of the wheel at the contact, m.
+    rolling_radius: f64,
 }
 
 impl ContactState {
@@ -172,12 +210,118 @@ struct WheelsetState {
     count: [usize; 2],
     /// Track frame axes in SC0 (columns x, y, z).
     track_axes: Matrix3<f64>,
+    /// Elastic rails: per rail (left, right) the displacement (d_y, d_z), m,
+    /// and its rate, m/s, in the track frame; zero for rigid rails.
+    rail_d: [[f64; 2]; 2],
+    rail_v: [[f64; 2]; 2],
 }
 
 impl WheelsetState {
     /// The contacts of side 0 (left) or 1 (right).
     fn side(&self, side: usize) -> &[ContactState] {
         &self.contacts[side][..self.count[side]]
+    }
+}
+
+/// One side (wheel and rail) of the wheelset at one state: what its contacts
+/// share.
+struct Side<'a> {
+    ctx: &'a ForceContext<'a>,
+    b: &'a Bound,
+    /// 0 left, 1 right.
+    side: usize,
+    /// +1 left, −1 right.
+    sign: f64,
+    /// Lateral shift of the wheelset over this rail (its irregularity taken
+    /// off), m.
+    y: f64,
+    /// Roll of the wheelset, rad.
+    roll: f64,
+    /// Height of the axle above the nominal radius, less the rail's vertical
+    /// irregularity, m.
+    z: f64,
+    /// Yaw of the axle, rad.
+    yaw: f64,
+    /// Longitudinal position of the axle in the track frame, m.
+    x_rel: f64,
+    /// The rail's rigid shift by irregularities (lateral, vertical), m.
+    shift: (f64, f64),
+    /// Track frame axes and origin, SC0.
+    axes: Matrix3<f64>,
+    origin: Vector3<f64>,
+    /// Axle direction, SC0.
+    axle: Vector3<f64>,
+    /// Rolling speed dividing the creepages, m/s.
+    speed: f64,
+    /// Body carrying this wheel.
+    wheel: usize,
+}
+
+/// One contact before its normal force is known.
+struct ContactKinematics {
+    shape: HertzShape,
+    /// Approach along the normal (load weight included), m.
+    approach: f64,
+    /// Normal (n_y, n_z) in the track cross-section.
+    normal_2d: [f64; 2],
+    cos_angle: f64,
+    point: Vector3<f64>,
+    ex: Vector3<f64>,
+    ey: Vector3<f64>,
+    n: Vector3<f64>,
+    /// Rate of approach of the wheel surface along the normal, m/s.
+    approach_rate: f64,
+    /// Creepages against a rail at rest.
+    creepages: Creepages,
+    speed: f64,
+    angle: f64,
+    rail_y: f64,
+    rolling_radius: f64,
+}
+
+/// The contact geometry of one wheel on its elastic rail for
+/// [`elastic_rail::solve`]: the table's region contacts with the wheelset
+/// shifted by −d_y over the rail and the gap closed by d_z.
+struct TableRail<'a> {
+    el: &'a WheelRailContact,
+    s: &'a Side<'a>,
+}
+
+impl RailContactGeometry for TableRail<'_> {
+    fn contacts_at(
+        &self,
+        d: [f64; 2],
+        out: &mut [RailContact; elastic_rail::MAX_CONTACTS],
+    ) -> Result<usize, ElasticRailError> {
+        let geo = |e: SimError| ElasticRailError::Geometry {
+            index: 0,
+            what: e.to_string(),
+        };
+        let sets = self.el.lookup(self.s, d[0]).map_err(geo)?;
+        for (o, c) in out.iter_mut().zip(&sets[self.s.side]) {
+            *o = match self.el.kinematics(self.s, c, d).map_err(geo)? {
+                Some(k) => RailContact {
+                    approach: k.approach,
+                    normal: k.normal_2d,
+                    hertz: k.shape,
+                    creepages: k.creepages,
+                },
+                // Open (or a boundary point without load): no force; any
+                // valid shape will do.
+                None => {
+                    let (sd, cd) = c.contact_angle.sin_cos();
+                    RailContact {
+                        approach: 0.0,
+                        normal: [-self.s.sign * sd, cd],
+                        hertz: self.el.placeholder_shape.ok_or_else(|| {
+                            ElasticRailError::Parameter("no Hertz shape for an open contact".into())
+                        })?,
+                        creepages: Creepages::default(),
+                    }
+                }
+            };
+        }
+        Ok(2)
     }
 }
 
@@ -194,6 +338,13 @@ pub struct WheelRailContact {
     /// Jacobian usually ask again for the state the last force evaluation
     /// saw, and the contact solution is the costly part of a step.
     last: std::sync::Mutex<Option<(f64, BodyKinematics, WheelsetState)>>,
+    /// Elastic rails: the rails' displacements (left, right; (d_y, d_z) each,
+    /// m) at the last accepted steps with their times, newest last. Only
+    /// [`ForceElement::accept_step`] changes it. Several steps are kept: the
+    /// output rows between two accepted steps are evaluated one step later.
+    rail_history: [Option<(f64, [[f64; 2]; 2])>; RAIL_HISTORY],
+    /// A valid Hertz shape for contacts without load (elastic rails).
+    placeholder_shape: Option<HertzShape>,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -229,6 +380,8 @@ impl WheelRailContact {
             bound: None,
             maxima: Maxima::default(),
             last: std::sync::Mutex::new(None),
+            rail_history: [None; RAIL_HISTORY],
+            placeholder_shape: HertzShape::with_modulus(1.0, 1.0, 1.0).ok(),
         }
     }
 
@@ -388,96 +541,233 @@ impl WheelRailContact {
             (dev.left_lateral + 0.5 * widening, dev.left_vertical),
             (dev.right_lateral - 0.5 * widening, dev.right_vertical),
         ];
-        let table = &b.contact.table;
-        let lookup = |y: f64| {
-            table.lookup_regions(y, roll).map_err(|e| {
-                self.diverged(
-                    t,
-                    format!(
-                        "wheelset out of the contact table ({e}); lateral shift {:.2} mm, roll \
-                         {:.4} rad: derailment, or enlarge `table`",
-                        rel.y * 1e3,
-                        roll
-                    ),
-                )
-            })
-        };
-        let left_sets = lookup(rel.y - rail_shift[0].0)?;
-        let right_sets = if rail_shift[1].0 == rail_shift[0].0 {
-            left_sets
-        } else {
-            lookup(rel.y - rail_shift[1].0)?
-        };
-        let sets: [&[Contact; 2]; 2] = [&left_sets[0], &right_sets[1]];
         let z_geom = rel.z - b.contact.nominal_radius;
         let mut state = WheelsetState {
             track_axes: axes,
             ..WheelsetState::default()
         };
         let forward = axes.column(0).into_owned();
-        for side in 0..2 {
-            let (dy, dz) = rail_shift[side];
-            let sign = if side == 0 { 1.0 } else { -1.0 };
-            for c in sets[side] {
-                let penetration = -(c.gap + z_geom - dz);
-                // A region's deepest point on the region boundary, where the
-                // surfaces still close towards the other region (distance
-                // slope ≠ 0), is not a contact of its own: the other region's
-                // slot holds it. Its load fades out with the slope; a true
-                // minimum born on the boundary has zero slope, so the load is
-                // continuous.
-                let weight = 1.0 - smoothstep(c.distance_slope.abs() / BOUNDARY_SLOPE);
-                if penetration <= 0.0 || weight == 0.0 {
-                    continue;
+        let speed = body.velocity.dot(&forward).abs().max(MIN_ROLLING_SPEED);
+        let sides = [0, 1].map(|side| Side {
+            ctx,
+            b,
+            side,
+            sign: if side == 0 { 1.0 } else { -1.0 },
+            y: rel.y - rail_shift[side].0,
+            roll,
+            z: z_geom - rail_shift[side].1,
+            yaw,
+            x_rel: rel.x,
+            shift: rail_shift[side],
+            axes,
+            origin,
+            axle,
+            speed,
+            wheel: self.wheel_body(side),
+        });
+        match self.c.rail {
+            None => {
+                let left = self.lookup(&sides[0], 0.0)?;
+                let right = if sides[1].y == sides[0].y {
+                    left
+                } else {
+                    self.lookup(&sides[1], 0.0)?
+                };
+                let sets: [&[Contact; 2]; 2] = [&left[0], &right[1]];
+                for (side, geo) in sides.iter().enumerate() {
+                    for c in sets[side] {
+                        let Some(k) = self.kinematics(geo, c, [0.0; 2])? else {
+                            continue;
+                        };
+                        let elastic = k
+                            .shape
+                            .normal_force(k.approach)
+                            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+                        let normal = (elastic + self.c.normal_damping * k.approach_rate).max(0.0);
+                        if normal == 0.0 {
+                            continue;
+                        }
+                        let stiffness = if elastic > 0.0 {
+                            k.shape.stiffness(k.approach)
+                        } else {
+                            0.0
+                        };
+                        let hertz = k
+                            .shape
+                            .contact(normal)
+                            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+                        let patch = self.patch(hertz.a, hertz.b, normal);
+                        let forces = b
+                            .law
+                            .forces(&patch, &k.creepages)
+                            .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
+                        let st = self.contact_state(&k, &patch, normal, stiffness, forces)?;
+                        let n = state.count[side];
+                        state.contacts[side][n] = st;
+                        state.count[side] += 1;
+                    }
                 }
-                let st = self.contact(
-                    ctx,
-                    b,
-                    c,
-                    // N ∝ approach^{3/2}: the load scales by `weight`.
-                    penetration * weight.powf(2.0 / 3.0),
-                    sign,
-                    yaw,
-                    rel.x,
-                    dy,
-                    dz,
-                    &axes,
-                    &origin,
-                    &axle,
-                    &forward,
-                )?;
-                if st.normal > 0.0 {
-                    let k = state.count[side];
-                    state.contacts[side][k] = st;
-                    state.count[side] += 1;
+            }
+            Some(support) => {
+                let (h, d_prev) = self.rail_reference(t);
+                for (side, geo) in sides.iter().enumerate() {
+                    self.solve_elastic_side(geo, &support, h, d_prev[side], &mut state)?;
                 }
             }
         }
         Ok(state)
     }
 
-    /// One contact: normal force, frame, creepages and creep forces.
-    #[allow(clippy::too_many_arguments)]
-    fn contact(
+    /// The contact table's region contacts for a side's wheelset position
+    /// with its rail displaced laterally by `rail_dy` (m).
+    fn lookup(&self, s: &Side, rail_dy: f64) -> Result<[[Contact; 2]; 2], SimError> {
+        let y = s.y - rail_dy;
+        s.b.contact.table.lookup_regions(y, s.roll).map_err(|e| {
+            self.diverged(
+                s.ctx.t,
+                format!(
+                    "wheelset out of the contact table ({e}); lateral shift {:.2} mm, roll \
+                     {:.4} rad: derailment, or enlarge `table`",
+                    y * 1e3,
+                    s.roll
+                ),
+            )
+        })
+    }
+
+    /// The body carrying wheel `side` (0 left, 1 right): the wheel's own body
+    /// for independently rotating wheels, else the wheelset.
+    fn wheel_body(&self, side: usize) -> usize {
+        self.spec.wheels.map_or(self.spec.wheelset, |w| w[side])
+    }
+
+    /// Where the backward-Euler rate of the elastic rails starts from at time
+    /// `t` (s): (h, d_prev) with d_prev the rails' displacements (left, right;
+    /// (d_y, d_z) each, m) at the latest accepted step before `t` and h the
+    /// time since it (s). Without an accepted step before `t` (the start of a
+    /// run) the rails are in static equilibrium: h = ∞.
+    fn rail_reference(&self, t: f64) -> (f64, [[f64; 2]; 2]) {
+        match self
+            .rail_history
+            .iter()
+            .rev()
+            .flatten()
+            .find(|(tr, _)| *tr < t)
+        {
+            Some((tr, d)) => (t - tr, *d),
+            None => (
+                f64::INFINITY,
+                self.rail_history[RAIL_HISTORY - 1].map_or([[0.0; 2]; 2], |(_, d)| d),
+            ),
+        }
+    }
+
+    /// One side on its massless elastic rail (seed paper Sect. 4.2, via
+    /// [`elastic_rail::solve`]): the rail displacement and the normal and
+    /// creep forces in equilibrium, written into `state`.
+    fn solve_elastic_side(
         &self,
-        ctx: &ForceContext,
-        b: &Bound,
+        s: &Side,
+        support: &RailSupport,
+        h: f64,
+        d_prev: [f64; 2],
+        state: &mut WheelsetState,
+    ) -> Result<(), SimError> {
+        let t = s.ctx.t;
+        let material = ContactMaterial {
+            g: self.c.shear,
+            nu: self.c.poisson,
+            mu: self.c.mu,
+        };
+        // The support's effective stiffness over the step, K + C/h (the
+        // backward-Euler damper).
+        let keff = if h.is_finite() {
+            [support.ky + support.cy / h, support.kz + support.cz / h]
+        } else {
+            [support.ky, support.kz]
+        };
+        let settings = ElasticRailSettings {
+            h,
+            v_roll: s.speed,
+            // 1 µN against wheel loads of tens of kN (what the integrator
+            // resolves at tolerances down to 1e-14 m against the 1e8 N/m
+            // support), above rounding (≈ 1e-11 N) except on the tiny first
+            // steps, where C/h is huge and the damper's forces K_eff·d round
+            // at about 1e-16 of themselves.
+            force_tol: 1e-6_f64
+                .max(1e-14 * keff[0].max(keff[1]) * (d_prev[0].hypot(d_prev[1]) + 1e-6)),
+            rel_tol: 1e-8,
+            max_inner: 50,
+            max_outer: 50,
+        };
+        let side_name = ["left", "right"][s.side];
+        let sol = elastic_rail::solve(
+            support,
+            &material,
+            &TableRail { el: self, s },
+            s.b.law.as_ref(),
+            d_prev,
+            &settings,
+        )
+        .map_err(|e| self.diverged(t, format!("{side_name} rail: {e}")))?;
+        let d = sol.displacement;
+        state.rail_d[s.side] = d;
+        state.rail_v[s.side] = sol.velocity;
+        let sets = self.lookup(s, d[0])?;
+        for (i, c) in sets[s.side].iter().enumerate().take(sol.n_contacts) {
+            let r = &sol.contacts[i];
+            if r.normal_force <= 0.0 {
+                continue;
+            }
+            let Some(mut k) = self.kinematics(s, c, d)? else {
+                continue;
+            };
+            // The rail's own velocity in the lateral creepage, as the solver
+            // used it: Δη = −(ḋ·t)/V, t = (n_z, −n_y) in the cross-section.
+            let [ny, nz] = r.normal;
+            k.creepages.eta -= (sol.velocity[0] * nz - sol.velocity[1] * ny) / s.speed;
+            // Hertz spring in series with the rail support along the normal:
+            // 1/k = 1/k_H + nᵀ K_eff⁻¹ n.
+            let k_hertz = k.shape.stiffness(r.approach);
+            let compliance = ny * ny / keff[0] + nz * nz / keff[1];
+            let stiffness = if k_hertz > 0.0 {
+                k_hertz / (1.0 + k_hertz * compliance)
+            } else {
+                0.0
+            };
+            let patch = self.patch(r.a, r.b, r.normal_force);
+            let st = self.contact_state(&k, &patch, r.normal_force, stiffness, r.creep)?;
+            let n = state.count[s.side];
+            state.contacts[s.side][n] = st;
+            state.count[s.side] += 1;
+        }
+        Ok(())
+    }
+
+    /// One contact's geometry, frame and creepages with the rail displaced
+    /// elastically by `d` = (d_y, d_z) (m, track frame; zero for rigid
+    /// rails); `None` if it cannot carry load (open gap, or a region's
+    /// boundary point that has lost its load).
+    fn kinematics(
+        &self,
+        s: &Side,
         c: &Contact,
-        penetration: f64,
-        sign: f64,
-        yaw: f64,
-        x_rel: f64,
-        dy: f64,
-        dz: f64,
-        axes: &Matrix3<f64>,
-        origin: &Vector3<f64>,
-        axle: &Vector3<f64>,
-        forward: &Vector3<f64>,
-    ) -> Result<ContactState, SimError> {
-        let t = ctx.t;
-        let body = &ctx.bodies[self.spec.wheelset];
+        d: [f64; 2],
+    ) -> Result<Option<ContactKinematics>, SimError> {
+        let t = s.ctx.t;
+        let penetration = -(c.gap + s.z - d[1]);
+        // A region's deepest point on the region boundary, where the
+        // surfaces still close towards the other region (distance slope ≠ 0),
+        // is not a contact of its own: the other region's slot holds it. Its
+        // load fades out with the slope; a true minimum born on the boundary
+        // has zero slope, so the load is continuous.
+        let weight = 1.0 - smoothstep(c.distance_slope.abs() / BOUNDARY_SLOPE);
+        if penetration <= 0.0 || weight == 0.0 {
+            return Ok(None);
+        }
         let (sd, cd) = c.contact_angle.sin_cos();
-        let approach = penetration * cd;
+        // N ∝ approach^{3/2}: the load scales by `weight`.
+        let approach = penetration * weight.powf(2.0 / 3.0) * cd;
         // Hertz shape from the curvatures at the contact.
         let (curv_a, curv_b) = wheel_rail_curvatures(
             1.0 / c.wheel_longitudinal_curvature.max(1e-6),
@@ -487,69 +777,89 @@ impl WheelRailContact {
         let curv_b = curv_b.max(MIN_CURVATURE_RATIO * curv_a);
         let shape = HertzShape::with_modulus(curv_a, curv_b, self.c.e_star)
             .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
-        let elastic = shape
-            .normal_force(approach)
-            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
-        let normal_stiffness = shape.stiffness(approach);
         // Contact point on the (displaced) rail, in the track frame then SC0.
         let local = Vector3::new(
             // Overswing of the contact ahead of the axle plane, r tan δ ψ
             // (small ψ), with tan δ bounded by the steepest real flange
             // (75°): a region's deepest point on the region boundary can
             // carry a meaningless near-vertical slope.
-            x_rel
+            s.x_rel
                 + (c.yaw_lead.clamp(
                     -MAX_LEAD_TAN * c.rolling_radius,
                     MAX_LEAD_TAN * c.rolling_radius,
-                )) * yaw,
-            c.rail_y + dy,
-            c.rail_z + dz,
+                )) * s.yaw,
+            c.rail_y + s.shift.0 + d[0],
+            c.rail_z + s.shift.1 + d[1],
         );
-        let point = origin + axes * local;
-        let n = axes * Vector3::new(0.0, -sign * sd, cd);
-        let ex = axle.cross(&n).normalize();
+        let point = s.origin + s.axes * local;
+        let n = s.axes * Vector3::new(0.0, -s.sign * sd, cd);
+        let ex = s.axle.cross(&n).normalize();
         let ey = n.cross(&ex);
-        let rho = point - body.position;
-        let v_wheel = body.velocity + body.angular_velocity.cross(&rho);
+        // The wheel: the wheelset, or its own body for independently
+        // rotating wheels.
+        let wheel = &s.ctx.bodies[s.wheel];
+        let rho = point - wheel.position;
+        let v_wheel = wheel.velocity + wheel.angular_velocity.cross(&rho);
         // Approach rate: the wheel's surface moving against the normal at the
         // contact point. The spin about the axle only rolls the surface
         // through the contact (its material velocity there has a normal
         // component Ω x_c when the contact leads the axle plane by x_c, e.g.
         // on a yawed flange), so the approach uses the non-spinning motion.
-        let omega_frame = body.angular_velocity - *axle * body.angular_velocity.dot(axle);
-        let approach_rate = -(body.velocity + omega_frame.cross(&rho)).dot(&n);
-        let normal = (elastic + self.c.normal_damping * approach_rate).max(0.0);
-        if normal == 0.0 {
-            return Ok(ContactState::default());
-        }
-        let speed = body.velocity.dot(forward).abs().max(MIN_ROLLING_SPEED);
+        let omega_frame = wheel.angular_velocity - s.axle * wheel.angular_velocity.dot(&s.axle);
+        let approach_rate = -(wheel.velocity + omega_frame.cross(&rho)).dot(&n);
         let creepages = Creepages {
-            xi: v_wheel.dot(&ex) / speed,
-            eta: v_wheel.dot(&ey) / speed,
-            phi: body.angular_velocity.dot(&n) / speed,
+            xi: v_wheel.dot(&ex) / s.speed,
+            eta: v_wheel.dot(&ey) / s.speed,
+            phi: wheel.angular_velocity.dot(&n) / s.speed,
         };
-        let hertz = shape
-            .contact(normal)
-            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
-        let patch = ContactPatch {
-            a: hertz.a,
-            b: hertz.b,
+        Ok(Some(ContactKinematics {
+            shape,
+            approach,
+            normal_2d: [-s.sign * sd, cd],
+            cos_angle: cd,
+            point,
+            ex,
+            ey,
+            n,
+            approach_rate,
+            creepages,
+            speed: s.speed,
+            angle: c.contact_angle,
+            rail_y: local.y,
+            rolling_radius: c.rolling_radius,
+        }))
+    }
+
+    /// The contact patch for the creep law: semi-axes `a`, `b` (m), normal
+    /// force `n` (N).
+    fn patch(&self, a: f64, b: f64, n: f64) -> ContactPatch {
+        ContactPatch {
+            a,
+            b,
             g: self.c.shear,
             nu: self.c.poisson,
             mu: self.c.mu,
-            n: normal,
-        };
-        let forces = b
-            .law
-            .forces(&patch, &creepages)
-            .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
+            n,
+        }
+    }
+
+    /// The solved contact: normal force `normal` (N) with dN/dδ `stiffness`
+    /// (N/m) and the creep forces.
+    fn contact_state(
+        &self,
+        k: &ContactKinematics,
+        patch: &ContactPatch,
+        normal: f64,
+        stiffness: f64,
+        forces: CreepForces,
+    ) -> Result<ContactState, SimError> {
         // Linear creep coefficients (Kalker), scaled by the saturation of the
         // actual forces, for the approximate Jacobian (paper Sect. 6).
-        let k = KalkerCoefficients::interpolate_ab(hertz.a, hertz.b, self.c.poisson)
+        let kc = KalkerCoefficients::interpolate_ab(patch.a, patch.b, self.c.poisson)
             .ok_or_else(|| self.err("Poisson ratio outside Kalker's table"))?;
-        let gab = self.c.shear * hertz.a * hertz.b;
-        let (f11, f22) = (gab * k.c11, gab * k.c22);
-        let linear = (f11 * creepages.xi).hypot(f22 * creepages.eta);
+        let gab = self.c.shear * patch.a * patch.b;
+        let (f11, f22) = (gab * kc.c11, gab * kc.c22);
+        let linear = (f11 * k.creepages.xi).hypot(f22 * k.creepages.eta);
         let actual = forces.fx.hypot(forces.fy);
         let ratio = if linear > 0.0 {
             (actual / linear).min(1.0)
@@ -557,23 +867,20 @@ impl WheelRailContact {
             1.0
         };
         Ok(ContactState {
-            point,
-            ex,
-            ey,
-            n,
+            point: k.point,
+            ex: k.ex,
+            ey: k.ey,
+            n: k.n,
             normal,
-            normal_stiffness: if elastic > 0.0 {
-                normal_stiffness * cd
-            } else {
-                0.0
-            },
-            creepages,
+            normal_stiffness: stiffness * k.cos_angle,
+            creepages: k.creepages,
             forces,
             f11: f11 * ratio,
             f22: f22 * ratio,
-            speed,
-            angle: c.contact_angle,
-            rail_y: local.y,
+            speed: k.speed,
+            angle: k.angle,
+            rail_y: k.rail_y,
+            rolling_radius: k.rolling_radius,
         })
     }
 
@@ -628,6 +935,15 @@ impl ForceElement for WheelRailContact {
                 CreepLawKind::Mueller { exponent } => ev(exponent, "exponent")?,
                 _ => 0.0,
             },
+            rail: match &s.rail {
+                RailKind::Rigid => None,
+                RailKind::Elastic { ky, cy, kz, cz } => Some(RailSupport {
+                    ky: ev(ky, "rail.ky")?,
+                    cy: ev(cy, "rail.cy")?,
+                    kz: ev(kz, "rail.kz")?,
+                    cz: ev(cz, "rail.cz")?,
+                }),
+            },
         };
         for (field, v) in [
             ("radius", c.radius),
@@ -644,11 +960,30 @@ impl ForceElement for WheelRailContact {
         if c.mu < 0.0 || c.normal_damping < 0.0 || c.taping_offset < 0.0 {
             return Err(self.err("mu, normal_damping and taping_offset must not be negative"));
         }
-        if matches!(s.rail, RailKind::Elastic { .. }) {
-            return Err(self.err(
-                "elastic rails (`rail: Elastic(..)`) are not available in time simulation yet; \
-                 use `rail: Rigid`",
-            ));
+        if let Some(r) = &c.rail {
+            if !(r.ky.is_finite() && r.ky > 0.0 && r.kz.is_finite() && r.kz > 0.0) {
+                return Err(self.err(format!(
+                    "rail stiffnesses ky, kz must be positive and finite, got {} and {} N/m",
+                    r.ky, r.kz
+                )));
+            }
+            if !(r.cy.is_finite() && r.cy >= 0.0 && r.cz.is_finite() && r.cz >= 0.0) {
+                return Err(self.err(format!(
+                    "rail damping cy, cz must not be negative, got {} and {} N s/m",
+                    r.cy, r.cz
+                )));
+            }
+            // The elastic rail's equilibrium (seed paper Sect. 4.2) balances
+            // the Hertz force against the rail support: a damper along the
+            // contact normal has no place in it (the rail's dampers cy, cz
+            // act in series with the Hertz spring instead).
+            if c.normal_damping != 0.0 {
+                return Err(self.err(format!(
+                    "normal_damping must be 0 with elastic rails (the rail dampers cy, cz \
+                     damp the contact), got {} N s/m",
+                    c.normal_damping
+                )));
+            }
         }
         // The contact table is built from these when the track is bound.
         let geometry = |c: &Constants| (c.radius, c.flange_back_distance, c.taping_offset);
@@ -660,6 +995,7 @@ impl ForceElement for WheelRailContact {
         }
         self.c = c;
         *self.last.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
+        self.rail_history = [None; RAIL_HISTORY];
         Ok(())
     }
 
@@ -706,8 +1042,8 @@ impl ForceElement for WheelRailContact {
 
     fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
         let state = self.solve(ctx)?;
-        let body = Some(self.spec.wheelset);
         for side in 0..2 {
+            let body = Some(self.wheel_body(side));
             for c in state.side(side) {
                 add_force(wrenches, ctx, body, &c.point, &c.force());
                 add_moment(wrenches, body, &(c.n * c.forces.mz));
@@ -733,12 +1069,20 @@ impl ForceElement for WheelRailContact {
                 "contact_angle [rad]",
                 "contact_y [m]",
                 "contacts [-]",
+                "rolling_radius [m]",
             ] {
                 names.push(format!("{side}.{n}"));
             }
         }
         names.push("SumY [N]".into());
         names.push("Nadal [-]".into());
+        if self.c.rail.is_some() {
+            for side in ["L", "R"] {
+                for n in ["rail_dy [m]", "rail_dz [m]"] {
+                    names.push(format!("{side}.{n}"));
+                }
+            }
+        }
         names
     }
 
@@ -776,12 +1120,16 @@ impl ForceElement for WheelRailContact {
                 main.angle,
                 main.rail_y,
                 contacts.len() as f64,
+                main.rolling_radius,
             ]);
         }
         // Track-shifting force: lateral force on the track, positive left =
         // Y_left − Y_right in field-side terms.
         out.push(loads[0].1 - loads[1].1);
         out.push(self.bound.as_ref().map_or(f64::NAN, |b| b.nadal));
+        if self.c.rail.is_some() {
+            out.extend(state.rail_d.iter().flatten());
+        }
     }
 
     fn accept_step(&mut self, ctx: &ForceContext) {
@@ -802,6 +1150,25 @@ impl ForceElement for WheelRailContact {
         }
         m.axle_load_sum += loads[0].0 + loads[1].0;
         m.samples += 1;
+        // Elastic rails: this step's rail displacements become the start of
+        // the next step's damper rate (never changed inside Newton
+        // iterations or by rejected steps).
+        if self.c.rail.is_some() {
+            let entry = Some((ctx.t, state.rail_d));
+            let h = &mut self.rail_history;
+            match h[RAIL_HISTORY - 1] {
+                // A new run from an earlier time: forget the old one.
+                Some((t_last, _)) if ctx.t < t_last => {
+                    *h = [None; RAIL_HISTORY];
+                    h[RAIL_HISTORY - 1] = entry;
+                }
+                Some((t_last, _)) if ctx.t == t_last => h[RAIL_HISTORY - 1] = entry,
+                _ => {
+                    h.rotate_left(1);
+                    h[RAIL_HISTORY - 1] = entry;
+                }
+            }
+        }
     }
 
     fn assessment(&self) -> Vec<super::Assessment> {
@@ -858,7 +1225,14 @@ impl ForceElement for WheelRailContact {
                 let kv = -(c.f11 / c.speed) * (c.ex * c.ex.transpose())
                     - (c.f22 / c.speed) * (c.ey * c.ey.transpose())
                     - self.c.normal_damping * nn;
-                jac.add_point_pair(None, &c.point, Some(self.spec.wheelset), &c.point, &kq, &kv);
+                jac.add_point_pair(
+                    None,
+                    &c.point,
+                    Some(self.wheel_body(side)),
+                    &c.point,
+                    &kq,
+                    &kv,
+                );
             }
         }
         Ok(())
