@@ -19,6 +19,11 @@
 //! platform has a per-thread CPU clock (Linux), so other processes on a busy
 //! machine do not inflate them; elsewhere wall-clock time.
 //!
+//! A train file (`Train(...)`) in place of the model benchmarks the train: the
+//! evaluation times are summed over its vehicles (the train's M and k are
+//! block-diagonal in the vehicles), and the run is the whole train scenario by
+//! `run_train` with every vehicle on the same engine.
+//!
 //! The numeric engine is always measured. The symbolic engine comes from
 //! [`build_engine`]; when it is not available its columns are `null` in JSON
 //! and the table says why. `derive_s` is the symbolic derivation time of
@@ -108,7 +113,7 @@ pub enum BenchEngine {
 /// Arguments of `umsim bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Model file (RON).
+    /// Model file (RON), or a train file (`Train(...)`).
     pub model: PathBuf,
     /// Print one JSON object instead of the table.
     #[arg(long)]
@@ -544,22 +549,173 @@ pub fn default_scenario(model_file: &Path) -> Result<Scenario, String> {
     ))
 }
 
+/// Replaces the creep law of every wheel–rail element; `false` when the
+/// model has none.
+fn override_creep(model: &mut Model, law: &railmbs_models::CreepLawKind) -> bool {
+    let mut found = false;
+    for f in &mut model.forces {
+        if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {
+            w.creep = law.clone();
+            found = true;
+        }
+    }
+    found
+}
+
+/// True if the file's top-level value is a `Train(...)`.
+fn is_train_file(path: &Path) -> bool {
+    std::fs::read_to_string(path).is_ok_and(|t| {
+        t.lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with("//"))
+            .is_some_and(|l| l.starts_with("Train("))
+    })
+}
+
+/// Median time of `run_train` (no CSV) with every vehicle's engine from
+/// `make`, s, and the steps of a run.
+fn time_train_run(
+    train: &railmbs_models::TrainScenario,
+    models: &[Model],
+    make: &dyn Fn(&Model) -> Result<Box<dyn Equations>, String>,
+) -> Result<(f64, usize), String> {
+    let refs: Vec<&Model> = models.iter().collect();
+    let mut steps = 0;
+    let mut times = Vec::new();
+    let mut total = 0.0;
+    while times.len() < MAX_RUNS && (times.is_empty() || total < RUN_SECONDS) {
+        let engines = models.iter().map(make).collect::<Result<Vec<_>, _>>()?;
+        let watch = Stopwatch::start();
+        let summary = railmbs_runtime::train::run_train(train, &refs, engines, None, |_| {})
+            .map_err(|e| e.to_string())?;
+        let seconds = watch.seconds();
+        if let Some(e) = summary.error {
+            return Err(format!("the train run failed: {e}"));
+        }
+        steps = summary.steps;
+        total += seconds;
+        times.push(seconds);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok((times[times.len() / 2], steps))
+}
+
+/// `measure` for a train file: evaluations summed over the vehicles, the
+/// train run with each engine.
+fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
+    let train = railmbs_models::load_train(&args.model)?;
+    let law = args.creep.as_deref().map(parse_creep).transpose()?;
+    let mut models = Vec::new();
+    for v in &train.vehicles {
+        let mut m = railmbs_models::load_model(&v.model)?;
+        if let Some(law) = &law {
+            override_creep(&mut m, law);
+        }
+        models.push(m);
+    }
+    let mut numeric = EngineTimes::default();
+    let mut symbolic = EngineTimes::default();
+    let (mut derive_s, mut compile_s) = (Some(0.0), Some(0.0));
+    let add = |acc: &mut Option<f64>, x: Option<f64>| {
+        *acc = match (*acc, x) {
+            (Some(a), Some(b)) => Some(a + b),
+            _ => None,
+        }
+    };
+    let (mut numeric_sum, mut symbolic_sum) = (Some(0.0), Some(0.0));
+    for model in &models {
+        let params = model.default_parameter_values();
+        let states = random_states(model, &params, args.states);
+        let numeric_make = || build_engine(model, Engine::Numeric, None).map_err(|e| e.to_string());
+        let e = time_engine(model, &params, &states, &numeric_make)?.0;
+        add(&mut numeric_sum, Some(e));
+        if args.engine != BenchEngine::Numeric {
+            let start = Instant::now();
+            match build_engine(model, Engine::Symbolic, None) {
+                Err(e) => {
+                    symbolic.note = Some(format!("unavailable: {e}"));
+                    symbolic_sum = None;
+                }
+                Ok(_) => {
+                    let build_s = start.elapsed().as_secs_f64();
+                    let g = railmbs_codegen::generate(
+                        model,
+                        &railmbs_codegen::GenerateOptions::new(0),
+                    )?;
+                    let d = g.derive_time.as_secs_f64();
+                    add(&mut derive_s, Some(d));
+                    add(
+                        &mut compile_s,
+                        Some((build_s - d - g.emit_time.as_secs_f64()).max(0.0)),
+                    );
+                    let make =
+                        || build_engine(model, Engine::Symbolic, None).map_err(|e| e.to_string());
+                    add(
+                        &mut symbolic_sum,
+                        Some(time_engine(model, &params, &states, &make)?.0),
+                    );
+                }
+            }
+        }
+    }
+    numeric.eval_ns = numeric_sum;
+    let (t, n) = time_train_run(&train, &models, &|m| {
+        build_engine(m, Engine::Numeric, None).map_err(|e| e.to_string())
+    })?;
+    numeric.run_s = Some(t);
+    numeric.run_steps = Some(n);
+    if args.engine == BenchEngine::Numeric {
+        symbolic.note = Some("not requested (--engine numeric)".into());
+        (derive_s, compile_s) = (None, None);
+    } else if symbolic.note.is_none() {
+        symbolic.eval_ns = symbolic_sum;
+        let (t, n) = time_train_run(&train, &models, &|m| {
+            build_engine(m, Engine::Symbolic, None).map_err(|e| e.to_string())
+        })?;
+        symbolic.run_s = Some(t);
+        symbolic.run_steps = Some(n);
+    } else {
+        (derive_s, compile_s) = (None, None);
+    }
+    let name = args
+        .model
+        .file_stem()
+        .map_or("train".into(), |s| s.to_string_lossy().into_owned());
+    Ok(BenchReport {
+        model: format!("{name} (train of {})", train.vehicles.len()),
+        model_file: args.model.clone(),
+        dof: models.iter().map(|m| m.coordinates.len()).sum(),
+        bodies: models.iter().map(|m| m.bodies.len()).sum(),
+        states: args.states,
+        scenario: Some(train.source.clone()),
+        scenario_note: None,
+        numeric,
+        symbolic,
+        derive_s,
+        compile_s,
+        creep: args.creep.clone(),
+    })
+}
+
 /// Runs all measurements (no printing).
 pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
     if args.states == 0 {
         return Err("--states must be at least 1".into());
     }
+    if is_train_file(&args.model) {
+        if args.scenario.is_some() {
+            return Err(format!(
+                "{}: a train file is its own scenario; leave out --scenario",
+                args.model.display()
+            )
+            .into());
+        }
+        return measure_train(args);
+    }
     let mut model = railmbs_models::load_model(&args.model)?;
     if let Some(text) = &args.creep {
         let law = parse_creep(text)?;
-        let mut found = false;
-        for f in &mut model.forces {
-            if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {
-                w.creep = law.clone();
-                found = true;
-            }
-        }
-        if !found {
+        if !override_creep(&mut model, &law) {
             return Err(format!(
                 "--creep: model {} has no wheel–rail element",
                 args.model.display()

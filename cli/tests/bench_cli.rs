@@ -119,3 +119,33 @@ fn bench_rejects_zero_states_and_missing_models() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no_such_model.ron"));
 }
+
+#[test]
+fn bench_of_a_train_sums_its_vehicles_and_runs_the_train() {
+    let v = json(&umsim(&[
+        "bench",
+        "models/scenarios/train3_straight.ron",
+        "--json",
+        "--engine",
+        "numeric",
+        "--states",
+        "2",
+    ]));
+    for k in KEYS {
+        assert!(v.get(k).is_some(), "missing {k}");
+    }
+    // Three coaches of Vehicle 1 (42 coordinates each).
+    assert_eq!(v["dof"], 126);
+    positive(&v, "numeric_eval_ns");
+    positive(&v, "numeric_run_s");
+    assert!(v["symbolic_run_s"].is_null());
+    // A train is its own scenario.
+    let o = umsim(&[
+        "bench",
+        "models/scenarios/train3_straight.ron",
+        "--scenario",
+        "models/scenarios/vehicle1_tc1.ron",
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("train file"));
+}
