@@ -572,12 +572,15 @@ fn is_train_file(path: &Path) -> bool {
     })
 }
 
+/// Builds the engine of one vehicle's model.
+type VehicleEngines = dyn Fn(&Model) -> Result<Box<dyn Equations>, String>;
+
 /// Median time of `run_train` (no CSV) with every vehicle's engine from
 /// `make`, s, and the steps of a run.
 fn time_train_run(
     train: &railmbs_models::TrainScenario,
     models: &[Model],
-    make: &dyn Fn(&Model) -> Result<Box<dyn Equations>, String>,
+    make: &VehicleEngines,
 ) -> Result<(f64, usize), String> {
     let refs: Vec<&Model> = models.iter().collect();
     let mut steps = 0;

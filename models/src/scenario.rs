@@ -917,7 +917,7 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         }
         if let Some(rows) = &c.longitudinal
             && (rows.len() < 2
-                || rows.windows(2).any(|w| !(w[1].0 > w[0].0))
+                || rows.windows(2).any(|w| w[1].0 <= w[0].0)
                 || rows.iter().any(|(x, f)| !(x.is_finite() && f.is_finite())))
         {
             problems.push((

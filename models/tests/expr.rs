@@ -155,14 +155,14 @@ fn local_variables_evaluate_and_differentiate() {
     let resolve = |id: &str| names.iter().position(|n| n == id);
     let e = parse_expr_vars("a*x^2*y + sin(b*y) - x/WS1.r0", false, &VAR_NAMES, resolve).unwrap();
     assert!(e.has_vars() && !e.has_time());
-    let (x, y) = (0.3, -0.7);
-    let want = 2.0 * x * x * y + (3.0 * y as f64).sin() - x / 0.46;
+    let (x, y): (f64, f64) = (0.3, -0.7);
+    let want = 2.0 * x * x * y + (3.0 * y).sin() - x / 0.46;
     assert!((e.eval_vars(&P, 0.0, &[x, y]) - want).abs() < 1e-15);
     // Without the variables bound the value is NaN, never a silent number.
     assert!(e.eval(&P, 0.0).is_nan());
     for (i, exact) in [
         (0, 4.0 * x * y - 1.0 / 0.46),
-        (1, 2.0 * x * x + 3.0 * (3.0 * y as f64).cos()),
+        (1, 2.0 * x * x + 3.0 * (3.0 * y).cos()),
     ] {
         let d = e.var_derivative(i).eval_vars(&P, 0.0, &[x, y]);
         assert!(

@@ -460,7 +460,7 @@ impl Characteristic {
     /// what is wrong.
     pub fn new(rows: &[(f64, f64)], interpolation: Interpolation) -> Result<Self, String> {
         if rows.len() < 2
-            || rows.windows(2).any(|w| !(w[1].0 > w[0].0))
+            || rows.windows(2).any(|w| w[1].0 <= w[0].0)
             || rows.iter().any(|(x, f)| !(x.is_finite() && f.is_finite()))
         {
             return Err(format!(
