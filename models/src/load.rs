@@ -226,7 +226,9 @@ impl Cx<'_> {
             Value::Text(s) => s,
         };
         let names = &self.names;
-        match parse_expr_vars(s, false, &VAR_NAMES, |id| names.iter().position(|n| n == id)) {
+        match parse_expr_vars(s, false, &VAR_NAMES, |id| {
+            names.iter().position(|n| n == id)
+        }) {
             Ok(e) => {
                 if let Some(d) = &self.defaults {
                     let z = e.eval_vars(d, 0.0, &[0.0, 0.0]);
@@ -1862,7 +1864,8 @@ impl Cx<'_> {
                             &w,
                             Some("normal"),
                             None,
-                            "a Z-surface's normal follows from its slope: leave `normal` out".into(),
+                            "a Z-surface's normal follows from its slope: leave `normal` out"
+                                .into(),
                         );
                     }
                     if let Some(defs) = &self.defaults {
