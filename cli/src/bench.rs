@@ -129,15 +129,16 @@ pub struct Args {
     #[arg(long, default_value_t = 16)]
     pub states: usize,
     /// Creep-force law of every wheel–rail element, overriding the model's:
-    /// `fastsim-a[:STRIPS]`, `fastsim:N` (N × N elements), `kalker` or
-    /// `mueller`.
+    /// `fastsim-a[:STRIPS]`, `fastsim-a-integrated[:STRIPS]` (sliding zones
+    /// integrated with 8 nodes), `fastsim:N` (N × N elements), `kalker`,
+    /// `mueller` or `polach`.
     #[arg(long)]
     pub creep: Option<String>,
 }
 
 /// Parses `--creep`.
 pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
-    use railmbs_models::{CreepLawKind, Expr};
+    use railmbs_models::{CreepLawKind, Expr, SlidingZoneKind};
     let (name, n) = match text.split_once(':') {
         Some((a, b)) => (
             a,
@@ -150,6 +151,16 @@ pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
     match (name, n) {
         ("fastsim-a", n) => Ok(CreepLawKind::FastsimA {
             strips: n.unwrap_or(20),
+            sliding: SlidingZoneKind::Continuation,
+        }),
+        ("fastsim-a-integrated", n) => Ok(CreepLawKind::FastsimA {
+            strips: n.unwrap_or(20),
+            sliding: SlidingZoneKind::Integrated { nodes: 8 },
+        }),
+        ("polach", None) => Ok(CreepLawKind::Polach {
+            ka: 1.0,
+            ks: 1.0,
+            friction_decrease: None,
         }),
         ("fastsim", n) => {
             let n = n.unwrap_or(10);
@@ -160,7 +171,8 @@ pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
             exponent: Expr::Num(2.0),
         }),
         _ => Err(format!(
-            "--creep {text}: expected fastsim-a[:STRIPS], fastsim[:N], kalker or mueller"
+            "--creep {text}: expected fastsim-a[:STRIPS], fastsim-a-integrated[:STRIPS], \
+             fastsim[:N], kalker, mueller or polach"
         )),
     }
 }

@@ -275,6 +275,29 @@
 //! once (with its first inclusion). When a subsystem cannot be loaded, the
 //! including file is still checked, without errors about that instance's names.
 //!
+//! ### Wheel–rail contact
+//!
+//! A wheelset body on a track-following frame (`SixDof(..., track: Some(x))`)
+//! gets its wheel–rail forces from one element (see
+//! `models/vehicles/components/wheelset_s1002.ron`):
+//!
+//! ```text
+//! WheelRail(name: "contact", wheelset: "ws",
+//!           wheel_profile: "../../profiles/MBench_S1002_v3.prw",   // relative to the model file
+//!           rail_profile: "../../profiles/MBench_UIC60_v3.ban",
+//!           wheel_profile_right: None, rail_profile_right: None,   // default: mirrored left
+//!           rail_profile_inclined: true,      // the file is drawn inclined (else the track's 1:40 is applied)
+//!           radius: "r0", flange_back_distance: 1.360, taping_offset: 0.070,   // m
+//!           mu: 0.4, young: 2.1e11, poisson: 0.28, normal_damping: 0,        // -, Pa, -, N s/m
+//!           creep: FastsimA(strips: 20, sliding: Continuation),   // default
+//!           // or FastsimA(strips: 20, sliding: Integrated(nodes: 8))   accurate at flange spin
+//!           // or Fastsim(nx: 10, ny: 10) | Kalker | Mueller(exponent: 2)
+//!           // or Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))   (A, B s/m), optional
+//!           rail: Rigid,                      // or Elastic(ky: .., cy: .., kz: .., cz: ..)  N/m, N s/m
+//!           wheels: None,                     // independently rotating wheels: Some(("WheelL", "WheelR"))
+//!           table: (y_max: 0.025, dy: 1e-4, roll_max: 0.03, droll: 2e-3)),
+//! ```
+//!
 //! ## Scenario files
 //!
 //! ```ron

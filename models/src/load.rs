@@ -2351,7 +2351,7 @@ impl Cx<'_> {
                 }
                 CreepLawKind::Fastsim { nx: *nx, ny: *ny }
             }
-            RawCreepLaw::FastsimA { strips } => {
+            RawCreepLaw::FastsimA { strips, sliding } => {
                 if *strips == 0 {
                     self.err(
                         w,
@@ -2360,7 +2360,54 @@ impl Cx<'_> {
                         "FastSim_A needs at least one strip".into(),
                     );
                 }
-                CreepLawKind::FastsimA { strips: *strips }
+                if let SlidingZoneKind::Integrated { nodes } | SlidingZoneKind::Picard { nodes } =
+                    sliding
+                    && !(1..=32).contains(nodes)
+                {
+                    self.err(
+                        w,
+                        Some("creep"),
+                        None,
+                        format!("FastSim_A sliding-zone nodes must be in 1..=32, got {nodes}"),
+                    );
+                }
+                CreepLawKind::FastsimA {
+                    strips: *strips,
+                    sliding: *sliding,
+                }
+            }
+            RawCreepLaw::Polach {
+                ka,
+                ks,
+                friction_decrease,
+            } => {
+                for (key, v) in [("ka", ka), ("ks", ks)] {
+                    if !(*v > 0.0 && *v <= 1.0) {
+                        self.err(
+                            w,
+                            Some("creep"),
+                            None,
+                            format!("Polach {key} must be in (0, 1], got {v}"),
+                        );
+                    }
+                }
+                if let Some((a, b)) = friction_decrease
+                    && !(*a >= 0.0 && a.is_finite() && *b >= 0.0 && b.is_finite())
+                {
+                    self.err(
+                        w,
+                        Some("creep"),
+                        None,
+                        format!(
+                            "Polach friction_decrease (A, B) needs A ≥ 0 and B ≥ 0 s/m, got ({a}, {b})"
+                        ),
+                    );
+                }
+                CreepLawKind::Polach {
+                    ka: *ka,
+                    ks: *ks,
+                    friction_decrease: *friction_decrease,
+                }
             }
         };
         let rail = match raw.rail {

@@ -1,7 +1,7 @@
 //! The RON syntax of model files as serde types, before resolution: names are
 //! still strings and numeric fields are numbers or expression text.
 
-use crate::model::{Axis, Interpolation};
+use crate::model::{Axis, Interpolation, SlidingZoneKind};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, de::IgnoredAny};
 use std::fmt;
@@ -671,12 +671,33 @@ pub(crate) enum RawCreepLaw {
     },
     FastsimA {
         strips: usize,
+        #[serde(default)]
+        sliding: SlidingZoneKind,
     },
+    Polach {
+        #[serde(default = "one")]
+        ka: f64,
+        #[serde(default = "one")]
+        ks: f64,
+        #[serde(default, deserialize_with = "some_pair")]
+        friction_decrease: Option<(f64, f64)>,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn some_pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(f64, f64)>, D::Error> {
+    <(f64, f64)>::deserialize(d).map(Some)
 }
 
 impl Default for RawCreepLaw {
     fn default() -> Self {
-        RawCreepLaw::FastsimA { strips: 20 }
+        RawCreepLaw::FastsimA {
+            strips: 20,
+            sliding: SlidingZoneKind::Continuation,
+        }
     }
 }
 

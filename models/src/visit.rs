@@ -175,7 +175,8 @@ impl ForceKind {
                     CreepLawKind::Mueller { exponent } => f(exponent),
                     CreepLawKind::Kalker
                     | CreepLawKind::Fastsim { .. }
-                    | CreepLawKind::FastsimA { .. } => {}
+                    | CreepLawKind::FastsimA { .. }
+                    | CreepLawKind::Polach { .. } => {}
                 }
                 match rail {
                     RailKind::Elastic { ky, cy, kz, cz } => {

@@ -81,6 +81,17 @@ pub trait CreepLaw {
     fn name(&self) -> &'static str;
     /// Forces on the wheel for the given patch and creepages; validates inputs.
     fn forces(&self, patch: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError>;
+    /// Forces at the rolling speed `speed` (m/s), for laws whose friction
+    /// depends on the slip velocity (Polach's friction decrease); the others
+    /// ignore it.
+    fn forces_at_speed(
+        &self,
+        patch: &ContactPatch,
+        c: &Creepages,
+        _speed: f64,
+    ) -> Result<CreepForces, CreepError> {
+        self.forces(patch, c)
+    }
 }
 
 fn bad(name: &'static str, value: f64, expected: &'static str) -> CreepError {

@@ -69,10 +69,11 @@ use crate::equations::BodyKinematics;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{CreepLawKind, RailKind, WheelRail};
+use railmbs_models::{CreepLawKind, RailKind, SlidingZoneKind, WheelRail};
 use railmbs_track::{SpeedLaw, Track};
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+    Polach, SlidingZone,
 };
 use railmbs_wheelrail::elastic_rail::{
     self, ContactMaterial, ElasticRailError, ElasticRailSettings, RailContact, RailContactGeometry,
@@ -599,7 +600,7 @@ impl WheelRailContact {
                         let patch = self.patch(hertz.a, hertz.b, normal);
                         let forces = b
                             .law
-                            .forces(&patch, &k.creepages)
+                            .forces_at_speed(&patch, &k.creepages, k.speed)
                             .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
                         let st = self.contact_state(&k, &patch, normal, stiffness, forces)?;
                         let n = state.count[side];
@@ -1024,8 +1025,28 @@ impl ForceElement for WheelRailContact {
             CreepLawKind::Fastsim { nx, ny } => {
                 Box::new(Fastsim::new(*ny, *nx).map_err(|e| self.err(e))?)
             }
-            CreepLawKind::FastsimA { strips } => {
-                Box::new(FastsimA::new(*strips).map_err(|e| self.err(e))?)
+            CreepLawKind::FastsimA { strips, sliding } => {
+                let zone = match *sliding {
+                    SlidingZoneKind::Continuation => SlidingZone::Continuation,
+                    SlidingZoneKind::Integrated { nodes } => SlidingZone::Integrated { nodes },
+                    SlidingZoneKind::Picard { nodes } => SlidingZone::Picard { nodes },
+                };
+                Box::new(
+                    FastsimA::new(*strips)
+                        .and_then(|f| f.with_sliding(zone))
+                        .map_err(|e| self.err(e))?,
+                )
+            }
+            CreepLawKind::Polach {
+                ka,
+                ks,
+                friction_decrease,
+            } => {
+                let mut p = Polach::new().with_reduction(*ka, *ks);
+                if let Some((a, b)) = friction_decrease {
+                    p = p.and_then(|p| p.with_falling_friction(*a, *b, 0.0));
+                }
+                Box::new(p.map_err(|e| self.err(e))?)
             }
         };
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);

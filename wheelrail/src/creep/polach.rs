@@ -172,7 +172,7 @@ impl Polach {
     }
 
     /// Forces at vehicle speed `speed` (m/s) instead of the stored one.
-    pub fn forces_at_speed(
+    fn forces_at(
         &self,
         p: &ContactPatch,
         c: &Creepages,
@@ -271,7 +271,16 @@ impl CreepLaw for Polach {
         "polach"
     }
     fn forces(&self, p: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError> {
-        self.forces_at_speed(p, c, self.speed)
+        self.forces_at(p, c, self.speed)
+    }
+    /// Forces at vehicle speed `speed` (m/s) instead of the stored one.
+    fn forces_at_speed(
+        &self,
+        p: &ContactPatch,
+        c: &Creepages,
+        speed: f64,
+    ) -> Result<CreepForces, CreepError> {
+        self.forces_at(p, c, speed)
     }
 }
 
