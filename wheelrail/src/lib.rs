@@ -10,7 +10,7 @@
 //! - [`conicity`]: equivalent conicity by EN 15302;
 //! - [`hertz`]: Hertzian contact ellipse, approach, pressure;
 //! - [`creepage`]: creepages and spin from body velocities;
-//! - [`creep`]: creep-force laws (Kalker linear, Mueller, FASTSIM, FastSim_A);
+//! - [`creep`]: creep-force laws (Kalker linear, Mueller, FASTSIM, FastSim_A, Polach);
 //! - [`kalker`]: Kalker's creepage coefficients;
 //! - [`elastic_rail`]: massless elastic rail with inner/outer iterations.
 
