@@ -45,6 +45,7 @@ pub fn all_vehicles() -> Vec<Model> {
         })
         .collect();
     paths.sort();
+    paths.push(model_path("vehicles/components/wheelset_s1002_irw.ron")); // no vehicle uses it yet
     paths
         .iter()
         .map(|p| railmbs_models::load_model(p).unwrap_or_else(|e| panic!("{e}")))
