@@ -378,13 +378,19 @@ pub fn solve(
     let mut normal = [0.0; MAX_CONTACTS];
     let mut inner_total = 0;
     let mut n_contacts = 0;
+    // The displacement whose contacts `geo` holds (the geometry is the costly
+    // part: a line-search trial that is accepted is not evaluated again).
+    let mut geo_d = None;
     for outer in 1..=settings.max_outer {
         // Inner: Newton on R(d) = Keff d − rhs0 + Σ Fᵢ(d) = 0.
         let mut converged = false;
         let mut residual = f64::INFINITY;
         for _ in 0..settings.max_inner {
             inner_total += 1;
-            n_contacts = geometry.contacts_at(d, &mut geo)?;
+            if geo_d != Some(d) {
+                n_contacts = geometry.contacts_at(d, &mut geo)?;
+                geo_d = Some(d);
+            }
             let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
             let mut j = [[keff[0], 0.0], [0.0, keff[1]]];
             for (i, c) in geo[..n_contacts].iter().enumerate() {
@@ -424,7 +430,7 @@ pub fn solve(
             let mut accepted = false;
             for _ in 0..30 {
                 let trial = [d[0] + dd[0], d[1] + dd[1]];
-                let rt = residual_at(
+                let (rt, n) = residual_at(
                     geometry,
                     &mut geo,
                     trial,
@@ -432,6 +438,8 @@ pub fn solve(
                     rhs0,
                     (&creep_t, &creep_g, d_lin),
                 )?;
+                n_contacts = n;
+                geo_d = Some(trial);
                 if rt < r_norm || rt <= settings.force_tol {
                     d = trial;
                     accepted = true;
@@ -622,8 +630,9 @@ fn lateral_creep_coefficient(
     f22 * ratio
 }
 
-/// Norm of the inner residual at displacement `d`; `creep` holds the lateral
-/// creep forces, their slopes and the displacement they are linearised about.
+/// Norm of the inner residual at displacement `d` and the number of contacts
+/// (written into `geo`); `creep` holds the lateral creep forces, their slopes
+/// and the displacement they are linearised about.
 fn residual_at(
     geometry: &dyn RailContactGeometry,
     geo: &mut [RailContact; MAX_CONTACTS],
@@ -631,7 +640,7 @@ fn residual_at(
     keff: [f64; 2],
     rhs0: [f64; 2],
     creep: (&[f64; MAX_CONTACTS], &[f64; MAX_CONTACTS], [f64; 2]),
-) -> Result<f64, ElasticRailError> {
+) -> Result<(f64, usize), ElasticRailError> {
     let (creep_t, creep_g, d_lin) = creep;
     let n = geometry.contacts_at(d, geo)?;
     let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
@@ -646,5 +655,5 @@ fn residual_at(
         r[0] += nn * ny + ti * nz;
         r[1] += nn * nz - ti * ny;
     }
-    Ok(r[0].hypot(r[1]))
+    Ok((r[0].hypot(r[1]), n))
 }
