@@ -349,3 +349,48 @@ fn independently_rotating_wheels_roll_at_the_speed_of_their_own_path_in_a_curve(
         "ω r ratio {measured}, path ratio {expected}"
     );
 }
+
+/// `wheels` naming the axle itself (a solid wheelset written as IRW) is
+/// refused at loading, naming the field and the bodies.
+#[test]
+fn a_wheel_that_is_the_wheelset_is_refused() {
+    let path = model_path("vehicles/components/wheelset_s1002_irw.ron");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "wheels: Some((\"WheelL\", \"WheelR\"))",
+        "wheels: Some((\"ws\", \"WheelR\"))",
+    );
+    let err = railmbs_models::parse_model(&text, &path)
+        .unwrap_err()
+        .to_string();
+    println!("{err}");
+    assert!(
+        err.contains("wheels") && err.contains("two different bodies") && err.contains("\"ws\""),
+        "{err}"
+    );
+}
+
+/// A contact damper along the normal together with elastic rails (whose
+/// dampers already act in series with the Hertz spring) is refused with an
+/// error naming the element and the field.
+#[test]
+fn normal_damping_with_elastic_rails_is_refused() {
+    let path = model_path("vehicles/components/wheelset_on_springs_elastic_rail.ron");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("normal_damping: 0,", "normal_damping: 2e5,");
+    let model = railmbs_models::parse_model(&text, &path).unwrap();
+    let scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/wheelset_elastic_rail_30.ron"))
+            .unwrap();
+    let engine = Box::new(NumericEquations::new(&model));
+    let err = match railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {})
+    {
+        Err(e) => e.to_string(),
+        Ok(summary) => format!("{:?}", summary.error),
+    };
+    println!("{err}");
+    assert!(
+        err.contains("\"contact\"") && err.contains("normal_damping must be 0"),
+        "{err}"
+    );
+}
