@@ -248,7 +248,8 @@ pub struct ElasticRailSettings {
     /// Time step for the damping rate `ḋ = (d − d_prev)/h`, s; `f64::INFINITY`
     /// for the static problem.
     pub h: f64,
-    /// Rolling speed `V` (m/s) converting the rail velocity into creepage.
+    /// Rolling speed `V` (m/s): converts the rail velocity into creepage, and
+    /// is the speed of laws whose friction depends on it.
     pub v_roll: f64,
     /// Inner tolerance on the force residual, N.
     pub force_tol: f64,
@@ -589,7 +590,11 @@ fn creep_force(
         eta: c.creepages.eta - (vel[0] * t[0] + vel[1] * t[1]) / v_roll,
         ..c.creepages
     };
-    let f = law.forces(&patch, &cr).map_err(|e| contact_err(i, e))?;
+    // At the rolling speed, for laws whose friction falls with the slip
+    // velocity (Polach).
+    let f = law
+        .forces_at_speed(&patch, &cr, v_roll)
+        .map_err(|e| contact_err(i, e))?;
     Ok((f, hc.a))
 }
 
