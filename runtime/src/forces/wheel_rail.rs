@@ -338,7 +338,9 @@ pub struct WheelRailContact {
     /// wheelset's kinematics): the accept-step hook, the outputs and the
     /// Jacobian usually ask again for the state the last force evaluation
     /// saw, and the contact solution is the costly part of a step.
-    last: std::sync::Mutex<Option<(f64, BodyKinematics, WheelsetState)>>,
+    /// The kinematics are the wheelset's and each wheel's body's (the same
+    /// body thrice for a solid wheelset).
+    last: std::sync::Mutex<Option<(f64, [BodyKinematics; 3], WheelsetState)>>,
     /// Elastic rails: the rails' displacements (left, right; (d_y, d_z) each,
     /// m) at the last accepted steps with their times, newest last. Only
     /// [`ForceElement::accept_step`] changes it. Several steps are kept: the
@@ -479,9 +481,14 @@ impl WheelRailContact {
     }
 
     /// [`Self::solve_new`], or the stored result for the same time and
-    /// wheelset kinematics.
+    /// wheelset kinematics (the axle's and, for independently rotating wheels,
+    /// the wheels', whose spin alone changes the creep forces).
     fn solve(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
-        let body = ctx.bodies[self.spec.wheelset];
+        let body = [
+            ctx.bodies[self.spec.wheelset],
+            ctx.bodies[self.wheel_body(0)],
+            ctx.bodies[self.wheel_body(1)],
+        ];
         if let Ok(last) = self.last.lock()
             && let Some((t, k, state)) = last.as_ref()
             && *t == ctx.t
