@@ -430,3 +430,39 @@ fn newton_converges_on_the_analytic_jacobian_with_elastic_rails() {
         s.jacobian_evaluations
     );
 }
+
+/// The creep forces of an independently rotating wheel follow its own spin:
+/// the finite-difference Jacobian (which perturbs one wheel's spin rate
+/// alone) sees the wheel's longitudinal creep damping, so Newton's
+/// iterations converge and the Jacobian is seldom rebuilt. (When the
+/// element reused its contact solution for unchanged axle kinematics, the
+/// spin columns came out zero: 6779 steps, 2956 rejected, 1588 Jacobians.)
+/// Measured: about 2300 steps, 65 rejected, 3 Jacobians.
+#[test]
+fn the_finite_difference_jacobian_sees_each_wheels_spin() {
+    let mut scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/wheelset_irw_off_centre.ron"))
+            .unwrap();
+    if let IntegratorSpec::Park { jacobian, .. } = &mut scenario.integrator {
+        *jacobian = railmbs_models::JacobianKind::FiniteDifference;
+    }
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let engine = Box::new(NumericEquations::new(&model));
+    let s =
+        railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
+    assert!(s.error.is_none(), "{:?}", s.error);
+    println!(
+        "{} steps ({} rejected), {} Jacobians",
+        s.steps, s.rejected_steps, s.jacobian_evaluations
+    );
+    assert!(
+        s.jacobian_evaluations <= 10,
+        "{} Jacobians",
+        s.jacobian_evaluations
+    );
+    assert!(
+        s.rejected_steps * 10 < s.steps,
+        "{} rejected",
+        s.rejected_steps
+    );
+}
