@@ -212,9 +212,8 @@ struct WheelsetState {
     /// Track frame axes in SC0 (columns x, y, z).
     track_axes: Matrix3<f64>,
     /// Elastic rails: per rail (left, right) the displacement (d_y, d_z), m,
-    /// and its rate, m/s, in the track frame; zero for rigid rails.
+    /// in the track frame; zero for rigid rails.
     rail_d: [[f64; 2]; 2],
-    rail_v: [[f64; 2]; 2],
 }
 
 impl WheelsetState {
@@ -720,7 +719,6 @@ impl WheelRailContact {
         .map_err(|e| self.diverged(t, format!("{side_name} rail: {e}")))?;
         let d = sol.displacement;
         state.rail_d[s.side] = d;
-        state.rail_v[s.side] = sol.velocity;
         let sets = self.lookup(s, d[0])?;
         for (i, c) in sets[s.side].iter().enumerate().take(sol.n_contacts) {
             let r = &sol.contacts[i];
