@@ -234,3 +234,74 @@ fn vehicle1_on_perfect_straight_track_stays_centred() {
         "largest lateral displacement or yaw {worst:e}"
     );
 }
+
+/// A coasting free wheelset loses energy only through its contacts: after the
+/// release transient, the drop of its mechanical energy (translation,
+/// rotation, potential energy of its weight and of the constant axle load,
+/// elastic energy of the Hertz contacts) equals the integral of the power the wheel–rail element reports as
+/// dissipated (creep forces against the creepages, V·(F_x ξ + F_y η + M_z φ),
+/// plus the normal damper). The wheelset hunts (Klingel) and slows down by
+/// itself: nothing holds its speed.
+#[test]
+fn coasting_wheelset_loses_energy_only_through_its_contacts() {
+    let scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/free_wheelset_klingel.ron")).unwrap();
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let out = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
+    let (m, ixx, iyy, izz, load, g) = (1813.0, 1120.0, 112.0, 1120.0, 91300.0, 9.81);
+    let c = |n: &str| out.col(n);
+    let (t, z) = (c("time"), c("ws.z[m]"));
+    let (vx, vy, vz) = (c("ws.vx[m/s]"), c("ws.vy[m/s]"), c("ws.vz[m/s]"));
+    let (wx, wy, wz) = (c("ws.wx[rad/s]"), c("ws.wy[rad/s]"), c("ws.wz[rad/s]"));
+    let (rx, ry, rz) = (c("ws.rx[rad]"), c("ws.ry[rad]"), c("ws.rz[rad]"));
+    let elastic: Vec<f64> = c("contact.L.Eel [J]")
+        .iter()
+        .zip(c("contact.R.Eel [J]"))
+        .map(|(l, r)| l + r)
+        .collect();
+    let power: Vec<f64> = c("contact.L.P [W]")
+        .iter()
+        .zip(c("contact.R.P [W]"))
+        .map(|(l, r)| l + r)
+        .collect();
+    let energy = |i: usize| {
+        // ω in the body's axes: R = Rx(rx) Ry(ry) Rz(rz) (xyz Cardan angles).
+        let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), rx[i])
+            * nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), ry[i])
+            * nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), rz[i]);
+        let w = r.transpose() * nalgebra::Vector3::new(wx[i], wy[i], wz[i]);
+        0.5 * m * (vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i])
+            + 0.5 * (ixx * w.x * w.x + iyy * w.y * w.y + izz * w.z * w.z)
+            + (m * g + load) * z[i]
+            + elastic[i]
+    };
+    // From t = 1 s (the vertical release transient has decayed) to the end.
+    let i0 = t.iter().position(|&x| x >= 1.0).unwrap();
+    let mut dissipated = 0.0;
+    let mut worst: f64 = 0.0;
+    for i in i0 + 1..t.len() {
+        dissipated += 0.5 * (power[i] + power[i - 1]) * (t[i] - t[i - 1]);
+        worst = worst.max((energy(i0) - energy(i) - dissipated).abs());
+    }
+    let lost = energy(i0) - energy(t.len() - 1);
+    println!(
+        "energy lost {lost:.3} J, dissipated at the contacts {dissipated:.3} J, \
+         largest gap on the way {worst:.3} J"
+    );
+    assert!(dissipated > 5.0, "dissipated {dissipated} J");
+    // What is not exact: each time a wheel's contact point jumps across the
+    // S1002 tread (about 10 mm, near the centred position), the table's gap —
+    // linear in roll within a 2 mrad cell — and the lever arm of the jumped
+    // point disagree, and the balance steps by up to ~0.4 J; the steps
+    // alternate in sign. Measured: 3 % net over 5 s, 6 % at worst on the way.
+    // (Before the overswing was placed where the wheel's normal is the rail's,
+    // the rolling did work against the normal force: 22 % net and growing.)
+    assert!(
+        (lost - dissipated).abs() < 0.05 * dissipated,
+        "energy lost {lost} J, dissipated {dissipated} J"
+    );
+    assert!(
+        worst < 0.08 * dissipated,
+        "energy balance off by {worst} J of {dissipated} J dissipated"
+    );
+}

@@ -194,6 +194,13 @@ struct ContactState {
     rail_y: f64,
     /// Rolling radius of the wheel at the contact, m.
     rolling_radius: f64,
+    /// Power dissipated at the contact, W: the creep forces against the
+    /// creepages, −V (F_x ξ + F_y η + M_z φ) (the forces act on the wheel and
+    /// oppose the slip), plus the normal damper's force times the approach
+    /// rate (rigid rails).
+    dissipation: f64,
+    /// Elastic energy of the Hertz contact, (2/5) N δ (N ∝ δ^{3/2}), J.
+    elastic_energy: f64,
 }
 
 impl ContactState {
@@ -608,7 +615,14 @@ impl WheelRailContact {
                             .law
                             .forces_at_speed(&patch, &k.creepages, k.speed)
                             .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
-                        let st = self.contact_state(&k, &patch, normal, stiffness, forces)?;
+                        let damper_power = (normal - elastic) * k.approach_rate;
+                        let st = self.contact_state(
+                            &k,
+                            &patch,
+                            (normal, stiffness),
+                            forces,
+                            (damper_power, 0.4 * elastic * k.approach),
+                        )?;
                         let n = state.count[side];
                         state.contacts[side][n] = st;
                         state.count[side] += 1;
@@ -742,7 +756,15 @@ impl WheelRailContact {
                 0.0
             };
             let patch = self.patch(r.a, r.b, r.normal_force);
-            let st = self.contact_state(&k, &patch, r.normal_force, stiffness, r.creep)?;
+            // The rail supports' dampers are not counted in the contact's
+            // dissipation (they act between rail and ground).
+            let st = self.contact_state(
+                &k,
+                &patch,
+                (r.normal_force, stiffness),
+                r.creep,
+                (0.0, 0.4 * r.normal_force * r.approach),
+            )?;
             let n = state.count[s.side];
             state.contacts[s.side][n] = st;
             state.count[s.side] += 1;
@@ -783,34 +805,44 @@ impl WheelRailContact {
         let curv_b = curv_b.max(MIN_CURVATURE_RATIO * curv_a);
         let shape = HertzShape::with_modulus(curv_a, curv_b, self.c.e_star)
             .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
-        // Contact point on the (displaced) rail, in the track frame then SC0.
-        let local = Vector3::new(
-            // Overswing of the contact ahead of the axle plane, r tan δ ψ
-            // (small ψ), with tan δ bounded by the steepest real flange
-            // (75°): a region's deepest point on the region boundary can
-            // carry a meaningless near-vertical slope.
-            s.x_rel
-                + (c.yaw_lead.clamp(
-                    -MAX_LEAD_TAN * c.rolling_radius,
-                    MAX_LEAD_TAN * c.rolling_radius,
-                )) * s.yaw,
+        // Contact point on the (displaced) rail, in the track frame then SC0,
+        // first in the axle's plane.
+        let mut local = Vector3::new(
+            s.x_rel,
             c.rail_y + s.shift.0 + d[0],
             c.rail_z + s.shift.1 + d[1],
         );
-        let point = s.origin + s.axes * local;
-        let n = s.axes * Vector3::new(0.0, -s.sign * sd, cd);
-        let ex = s.axle.cross(&n).normalize();
-        let ey = n.cross(&ex);
         // The wheel: the wheelset, or its own body for independently
         // rotating wheels.
         let wheel = &s.ctx.bodies[s.wheel];
+        let n = s.axes * Vector3::new(0.0, -s.sign * sd, cd);
+        // Overswing: a yawed wheel touches the rail ahead of (or behind) its
+        // axle plane, where its surface normal — in the wheel's meridian
+        // plane, a body of revolution's normals lie there — is the rail's
+        // normal n: the circumferential direction u = axle × ρ is then
+        // orthogonal to n, so the rolling does no work against the normal
+        // force. Solved for the shift x along the track: (axle × (ρ₀ + x eₓ))·n
+        // = 0, x ≈ r tan δ ψ for small yaw ψ; bounded by the steepest real
+        // flange (tan δ ≤ 3.73), as a region's deepest point on the region
+        // boundary can carry a near-vertical slope.
+        let track_x = s.axes.column(0).into_owned();
+        let rho0 = s.origin + s.axes * local - wheel.position;
+        let denominator = s.axle.cross(&track_x).dot(&n);
+        if denominator.abs() > 1e-12 {
+            let bound = MAX_LEAD_TAN * c.rolling_radius * s.yaw.abs();
+            local.x += (-s.axle.cross(&rho0).dot(&n) / denominator).clamp(-bound, bound);
+        }
+        let point = s.origin + s.axes * local;
         let rho = point - wheel.position;
+        let ex = s.axle.cross(&n).normalize();
+        let ey = n.cross(&ex);
         let v_wheel = wheel.velocity + wheel.angular_velocity.cross(&rho);
         // Approach rate: the wheel's surface moving against the normal at the
         // contact point. The spin about the axle only rolls the surface
-        // through the contact (its material velocity there has a normal
-        // component Ω x_c when the contact leads the axle plane by x_c, e.g.
-        // on a yawed flange), so the approach uses the non-spinning motion.
+        // through the contact: with the overswing above its velocity there is
+        // orthogonal to n, except where the overswing bound cuts in; the
+        // approach uses the non-spinning motion, so that a bounded overswing
+        // does not feed the spin into the normal damper.
         let omega_frame = wheel.angular_velocity - s.axle * wheel.angular_velocity.dot(&s.axle);
         let approach_rate = -(wheel.velocity + omega_frame.cross(&rho)).dot(&n);
         let creepages = Creepages {
@@ -855,9 +887,9 @@ impl WheelRailContact {
         &self,
         k: &ContactKinematics,
         patch: &ContactPatch,
-        normal: f64,
-        stiffness: f64,
+        (normal, stiffness): (f64, f64),
         forces: CreepForces,
+        (damper_power, elastic_energy): (f64, f64),
     ) -> Result<ContactState, SimError> {
         // Linear creep coefficients (Kalker), scaled by the saturation of the
         // actual forces, for the approximate Jacobian (paper Sect. 6).
@@ -887,6 +919,12 @@ impl WheelRailContact {
             angle: k.angle,
             rail_y: k.rail_y,
             rolling_radius: k.rolling_radius,
+            dissipation: -k.speed
+                * (forces.fx * k.creepages.xi
+                    + forces.fy * k.creepages.eta
+                    + forces.mz * k.creepages.phi)
+                + damper_power,
+            elastic_energy,
         })
     }
 
@@ -1092,6 +1130,8 @@ impl ForceElement for WheelRailContact {
                 "eta [-]",
                 "spin [1/m]",
                 "Tgamma [N]",
+                "P [W]",
+                "Eel [J]",
                 "contact_angle [rad]",
                 "contact_y [m]",
                 "contacts [-]",
@@ -1143,6 +1183,8 @@ impl ForceElement for WheelRailContact {
                 sum(&|c| {
                     (c.forces.fx * c.creepages.xi).abs() + (c.forces.fy * c.creepages.eta).abs()
                 }),
+                sum(&|c| c.dissipation),
+                sum(&|c| c.elastic_energy),
                 main.angle,
                 main.rail_y,
                 contacts.len() as f64,
