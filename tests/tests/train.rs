@@ -328,7 +328,7 @@ fn a_symmetric_train_on_straight_track_stays_centred() {
         models.iter().map(|m| m.coordinates.len()).sum::<usize>(),
         126
     );
-    assert_eq!(summary.assessment.len(), 3 * 4 * 5);
+    assert_eq!(summary.assessment.len(), 3 * 4 * 8);
     let mut worst: f64 = 0.0;
     for (v, m) in train.vehicles.iter().zip(&models) {
         for c in m

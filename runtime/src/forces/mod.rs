@@ -11,6 +11,7 @@ pub mod contact;
 mod linear6;
 pub mod nonlinear;
 mod series;
+pub mod sliding_mean;
 pub mod wheel_rail;
 
 pub use applied::AppliedForce;
