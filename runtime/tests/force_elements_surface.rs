@@ -73,12 +73,14 @@ fn bead_in_a_bowl_swings_with_the_pendulum_period() {
     let periods: Vec<f64> = crossings.windows(2).map(|w| w[1] - w[0]).collect();
     // Small oscillation of a bead in a bowl of radius of curvature R: the
     // pendulum period 2π√(R/g). Corrections: the parabola's amplitude
-    // dependence ~(A/R)² = 1e-4, the contact's compliance (ω/ω_c)² ≈ 1e-6,
-    // the interpolated crossing with h ≤ 1e-3 s ~1e-6 s.
+    // dependence, of order (A/R)² = 1e-4 (measured: +2.7e-5), the contact's
+    // compliance (ω/ω_c)² ≈ 1e-6, the interpolated crossing with h ≤ 1e-3 s
+    // ~1e-6 s.
     let expected = 2.0 * PI * (1.0f64 / 9.81).sqrt();
+    println!("periods {periods:?} s, pendulum {expected} s");
     for p in &periods {
         assert!(
-            (p - expected).abs() < 5e-4 * expected,
+            (p - expected).abs() < 1e-4 * expected,
             "period {p} s, pendulum {expected} s"
         );
     }
