@@ -640,3 +640,54 @@ fn the_rail_damper_decays_the_bounce_as_springs_and_damper_in_series() {
         );
     }
 }
+
+/// As [`elastic_rails_balance_a_lateral_axle_force`], with the wheelset
+/// pushed by 40 kN from 6.5 mm off centre onto its left flange root (contact
+/// angle about 20° against the tread's 1.4°, the left wheel carrying 78 kN
+/// along its normal): the rails' lateral supports still carry F,
+/// k_y (d_y,L + d_y,R) = F within 1 % (same reasons as there). On this
+/// steep part of the profile the rail's Newton iterations need the
+/// finite-difference fallback of `elastic_rail::solve`.
+#[test]
+fn elastic_rails_balance_a_lateral_axle_force_on_the_flange_root() {
+    let force = 40e3;
+    let t = run_edited("scenarios/wheelset_elastic_rail_30.ron", |s| {
+        s.track.as_mut().unwrap().speed = 0.0;
+        set_parameters(
+            s,
+            &[
+                ("v0", "0"),
+                ("y0", "0.0065"),
+                ("kz", "0"),
+                ("ky", "0"),
+                ("Fy", "40e3"),
+            ],
+        );
+        s.end_time = 0.5;
+        s.output.interval = 0.01;
+        s.integrator = IntegratorSpec::Park {
+            rtol: 1e-7,
+            atol: 1e-10,
+            max_step: 0.005,
+            initial_step: None,
+            jacobian: Default::default(),
+        };
+    });
+    let (dl, dr) = (
+        last(&t, "contact.L.rail_dy [m]"),
+        last(&t, "contact.R.rail_dy [m]"),
+    );
+    let angle = last(&t, "contact.L.contact_angle [rad]");
+    let total = KY_RAIL * (dl + dr);
+    println!(
+        "left contact angle {angle:.3} rad; rail dy L {:.4} mm, R {:.4} mm: k_y Σd_y {total:.1} N \
+         against F {force} N",
+        dl * 1e3,
+        dr * 1e3
+    );
+    assert!(angle > 0.3, "not on the flange root: {angle} rad");
+    assert!(
+        (total - force).abs() < 0.01 * force,
+        "k_y Σd_y {total} N, F {force} N"
+    );
+}

@@ -41,6 +41,17 @@
 //! law's actual force), `d_k` the displacement of the last outer iteration.
 //! The converged solution is the same (the outer iterations stop when the
 //! creep forces at `d` no longer change); only the convergence is helped.
+//! (The scaled coefficient is at least the law's tangent, so the iterations
+//! contract monotonically, slowly in partial saturation; the law's exact
+//! tangent converges faster there but overshoots between the two saturated
+//! branches when the creepage is small, as at standstill.)
+//!
+//! The inner Newton step uses the contact normals (`dδ/dd = n`); where it
+//! does not lower the residual (the normal is not the approach's true
+//! gradient, e.g. a flange contact moving across the profiles' regions) it is
+//! retried once with a finite-difference Jacobian of the residual. The force
+//! tolerance is raised to the rounding of the residual's terms where those
+//! are huge (on tiny steps C/h and f₂₂/(V h)).
 //!
 //! The contact geometry is supplied through [`RailContactGeometry`] — "the
 //! contact geometry at a given rail displacement": [`ProfileRailContacts`]
@@ -394,6 +405,9 @@ pub fn solve(
             }
             let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
             let mut j = [[keff[0], 0.0], [0.0, keff[1]]];
+            // Size of the terms summed into r, for the rounding floor.
+            let mut terms = (keff[0] * d[0]).abs().max((keff[1] * d[1]).abs())
+                + rhs0[0].abs().max(rhs0[1].abs());
             for (i, c) in geo[..n_contacts].iter().enumerate() {
                 check_contact(i, c)?;
                 let nn = c
@@ -407,6 +421,7 @@ pub fn solve(
                 let ti = linear_creep(creep_t[i], creep_g[i], t, d, d_lin);
                 r[0] += nn * ny + ti * t[0];
                 r[1] += nn * nz + ti * t[1];
+                terms += nn + ti.abs() + creep_g[i] * (d[0] - d_lin[0]).hypot(d[1] - d_lin[1]);
                 // dFᵢ/dd = kn·n nᵀ (δ = δ₀ + n·d) + gᵢ t tᵀ.
                 let g = creep_g[i];
                 j[0][0] += kn * ny * ny + g * t[0] * t[0];
@@ -415,38 +430,57 @@ pub fn solve(
                 j[1][1] += kn * nz * nz + g * t[1] * t[1];
             }
             residual = r[0].hypot(r[1]);
-            if residual <= settings.force_tol {
+            // The residual cannot be resolved below the rounding of its terms
+            // and of d itself through the Jacobian (on tiny steps C/h and the
+            // creep damping f₂₂/(V h) make J huge).
+            let j_max = j.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let floor = 16.0 * f64::EPSILON * (terms + j_max * d[0].abs().max(d[1].abs()));
+            let tol = settings.force_tol.max(floor);
+            if residual <= tol {
                 converged = true;
                 break;
             }
-            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-            let mut dd = [
-                -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
-                -(-j[1][0] * r[0] + j[0][0] * r[1]) / det,
-            ];
+            let mut dd = newton_step(j, r);
             // Damped step: do not let an approach jump from positive far into
             // separation (Hertz is stiff at contact, zero beyond): halve the step
-            // while the residual norm would grow.
+            // while the residual norm would grow. If the step from the contact
+            // normals does not lower the residual at all (the normal is not
+            // the approach's true gradient, e.g. where a flange contact moves
+            // across the profiles' regions), retry once with a
+            // finite-difference Jacobian of the residual.
             let r_norm = residual;
+            let creep_lin = (&creep_t, &creep_g, d_lin);
             let mut accepted = false;
-            for _ in 0..30 {
-                let trial = [d[0] + dd[0], d[1] + dd[1]];
-                let (rt, n) = residual_at(
-                    geometry,
-                    &mut geo,
-                    trial,
-                    keff,
-                    rhs0,
-                    (&creep_t, &creep_g, d_lin),
-                )?;
-                n_contacts = n;
-                geo_d = Some(trial);
-                if rt < r_norm || rt <= settings.force_tol {
-                    d = trial;
-                    accepted = true;
+            for attempt in 0..2 {
+                if attempt == 1 {
+                    let h = 1e-9 + 1e-7 * d[0].abs().max(d[1].abs());
+                    let mut jfd = [[0.0; 2]; 2];
+                    for k in 0..2 {
+                        let mut dk = d;
+                        dk[k] += h;
+                        let (rk, _) = residual_at(geometry, &mut geo, dk, keff, rhs0, creep_lin)?;
+                        geo_d = Some(dk);
+                        jfd[0][k] = (rk[0] - r[0]) / (dk[k] - d[k]);
+                        jfd[1][k] = (rk[1] - r[1]) / (dk[k] - d[k]);
+                    }
+                    dd = newton_step(jfd, r);
+                }
+                for _ in 0..30 {
+                    let trial = [d[0] + dd[0], d[1] + dd[1]];
+                    let (rt, n) = residual_at(geometry, &mut geo, trial, keff, rhs0, creep_lin)?;
+                    n_contacts = n;
+                    geo_d = Some(trial);
+                    let rt = rt[0].hypot(rt[1]);
+                    if rt < r_norm || rt <= tol {
+                        d = trial;
+                        accepted = true;
+                        break;
+                    }
+                    dd = [0.5 * dd[0], 0.5 * dd[1]];
+                }
+                if accepted {
                     break;
                 }
-                dd = [0.5 * dd[0], 0.5 * dd[1]];
             }
             if !accepted {
                 break;
@@ -635,7 +669,16 @@ fn lateral_creep_coefficient(
     f22 * ratio
 }
 
-/// Norm of the inner residual at displacement `d` and the number of contacts
+/// The Newton step −J⁻¹ r of a 2×2 system.
+fn newton_step(j: [[f64; 2]; 2], r: [f64; 2]) -> [f64; 2] {
+    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    [
+        -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
+        -(-j[1][0] * r[0] + j[0][0] * r[1]) / det,
+    ]
+}
+
+/// The inner residual at displacement `d` and the number of contacts
 /// (written into `geo`); `creep` holds the lateral creep forces, their slopes
 /// and the displacement they are linearised about.
 fn residual_at(
@@ -645,7 +688,7 @@ fn residual_at(
     keff: [f64; 2],
     rhs0: [f64; 2],
     creep: (&[f64; MAX_CONTACTS], &[f64; MAX_CONTACTS], [f64; 2]),
-) -> Result<(f64, usize), ElasticRailError> {
+) -> Result<([f64; 2], usize), ElasticRailError> {
     let (creep_t, creep_g, d_lin) = creep;
     let n = geometry.contacts_at(d, geo)?;
     let mut r = [keff[0] * d[0] - rhs0[0], keff[1] * d[1] - rhs0[1]];
@@ -660,5 +703,5 @@ fn residual_at(
         r[0] += nn * ny + ti * nz;
         r[1] += nn * nz - ti * ny;
     }
-    Ok((r[0].hypot(r[1]), n))
+    Ok((r, n))
 }
