@@ -77,8 +77,8 @@ use railmbs_wheelrail::creep::{
     Polach, SlidingZone,
 };
 use railmbs_wheelrail::elastic_rail::{
-    self, ContactMaterial, ElasticRailError, ElasticRailSettings, RailContact, RailContactGeometry,
-    RailSupport,
+    self, ContactMaterial, CreepStart, ElasticRailError, ElasticRailSettings, RailContact,
+    RailContactGeometry, RailSupport,
 };
 use railmbs_wheelrail::geometry::{self, Contact, ContactTable, SearchSettings, TableSettings};
 use railmbs_wheelrail::hertz::{HertzShape, effective_modulus, wheel_rail_curvatures};
@@ -222,6 +222,9 @@ struct WheelsetState {
     /// Elastic rails: per rail (left, right) the displacement (d_y, d_z), m,
     /// in the track frame; zero for rigid rails.
     rail_d: [[f64; 2]; 2],
+    /// Elastic rails: per rail the creep forces the rail's outer iterations
+    /// converged to (where the next step's iterations start).
+    rail_creep: [CreepStart; 2],
 }
 
 impl WheelsetState {
@@ -333,6 +336,10 @@ impl RailContactGeometry for TableRail<'_> {
     }
 }
 
+/// The elastic rails at an accepted step: time (s), displacements (left,
+/// right; (d_y, d_z) each, m) and creep forces.
+type RailRecord = (f64, [[f64; 2]; 2], [CreepStart; 2]);
+
 /// The wheel–rail element of one wheelset.
 pub struct WheelRailContact {
     name: String,
@@ -355,7 +362,7 @@ pub struct WheelRailContact {
     /// m) at the last accepted steps with their times, newest last. Only
     /// [`ForceElement::accept_step`] changes it. Several steps are kept: the
     /// output rows between two accepted steps are evaluated one step later.
-    rail_history: [Option<(f64, [[f64; 2]; 2])>; RAIL_HISTORY],
+    rail_history: [Option<RailRecord>; RAIL_HISTORY],
     /// A valid Hertz shape for contacts without load (elastic rails).
     placeholder_shape: Option<HertzShape>,
 }
@@ -665,9 +672,10 @@ impl WheelRailContact {
                 }
             }
             Some(support) => {
-                let (h, d_prev) = self.rail_reference(t);
+                let (h, d_prev, creep) = self.rail_reference(t);
                 for (side, geo) in sides.iter().enumerate() {
-                    self.solve_elastic_side(geo, &support, h, d_prev[side], &mut state)?;
+                    let start = (h, d_prev[side], &creep[side]);
+                    self.solve_elastic_side(geo, &support, start, &mut state)?;
                 }
             }
         }
@@ -698,37 +706,39 @@ impl WheelRailContact {
     }
 
     /// Where the backward-Euler rate of the elastic rails starts from at time
-    /// `t` (s): (h, d_prev) with d_prev the rails' displacements (left, right;
-    /// (d_y, d_z) each, m) at the latest accepted step before `t` and h the
-    /// time since it (s). Without an accepted step before `t` (the start of a
+    /// `t` (s): (h, d_prev, creep) with d_prev the rails' displacements (left,
+    /// right; (d_y, d_z) each, m) at the latest accepted step before `t`, h
+    /// the time since it (s) and the creep forces there (where the outer
+    /// iterations start). Without an accepted step before `t` (the start of a
     /// run) the rails are in static equilibrium: h = ∞.
-    fn rail_reference(&self, t: f64) -> (f64, [[f64; 2]; 2]) {
+    fn rail_reference(&self, t: f64) -> (f64, [[f64; 2]; 2], [CreepStart; 2]) {
         match self
             .rail_history
             .iter()
             .rev()
             .flatten()
-            .find(|(tr, _)| *tr < t)
+            .find(|(tr, _, _)| *tr < t)
         {
-            Some((tr, d)) => (t - tr, *d),
-            None => (
-                f64::INFINITY,
-                self.rail_history[RAIL_HISTORY - 1].map_or([[0.0; 2]; 2], |(_, d)| d),
-            ),
+            Some((tr, d, creep)) => (t - tr, *d, *creep),
+            None => {
+                let (_, d, creep) = self.rail_history[RAIL_HISTORY - 1].unwrap_or_default();
+                (f64::INFINITY, d, creep)
+            }
         }
     }
 
     /// One side on its massless elastic rail (seed paper Sect. 4.2, via
-    /// [`elastic_rail::solve`]): the rail displacement and the normal and
-    /// creep forces in equilibrium, written into `state`.
+    /// [`elastic_rail::solve_from`]): the rail displacement and the normal
+    /// and creep forces in equilibrium, written into `state`; `start` is
+    /// (h, d_prev, creep) of [`Self::rail_reference`] for this rail.
     fn solve_elastic_side(
         &self,
         s: &Side,
         support: &RailSupport,
-        h: f64,
-        d_prev: [f64; 2],
+        start: (f64, [f64; 2], &CreepStart),
         state: &mut WheelsetState,
     ) -> Result<(), SimError> {
+        let (h, d_prev, creep_start) = start;
         let t = s.ctx.t;
         let material = ContactMaterial {
             g: self.c.shear,
@@ -755,17 +765,22 @@ impl WheelRailContact {
             max_outer: 200,
         };
         let side_name = ["left", "right"][s.side];
-        let sol = elastic_rail::solve(
+        let sol = elastic_rail::solve_from(
             support,
             &material,
             &TableRail { el: self, s },
             s.b.law.as_ref(),
             d_prev,
+            creep_start,
             &settings,
         )
         .map_err(|e| self.diverged(t, format!("{side_name} rail: {e}")))?;
         let d = sol.displacement;
         state.rail_d[s.side] = d;
+        state.rail_creep[s.side] = CreepStart {
+            forces: sol.contacts.map(|c| c.creep),
+            slope: sol.contacts.map(|c| c.lateral_slope),
+        };
         let sets = self.lookup(s, d[0])?;
         for (i, c) in sets[s.side].iter().enumerate().take(sol.n_contacts) {
             let r = &sol.contacts[i];
@@ -1282,15 +1297,15 @@ impl ForceElement for WheelRailContact {
         // the next step's damper rate (never changed inside Newton
         // iterations or by rejected steps).
         if self.c.rail.is_some() {
-            let entry = Some((ctx.t, state.rail_d));
+            let entry = Some((ctx.t, state.rail_d, state.rail_creep));
             let h = &mut self.rail_history;
             match h[RAIL_HISTORY - 1] {
                 // A new run from an earlier time: forget the old one.
-                Some((t_last, _)) if ctx.t < t_last => {
+                Some((t_last, _, _)) if ctx.t < t_last => {
                     *h = [None; RAIL_HISTORY];
                     h[RAIL_HISTORY - 1] = entry;
                 }
-                Some((t_last, _)) if ctx.t == t_last => h[RAIL_HISTORY - 1] = entry,
+                Some((t_last, _, _)) if ctx.t == t_last => h[RAIL_HISTORY - 1] = entry,
                 _ => {
                     h.rotate_left(1);
                     h[RAIL_HISTORY - 1] = entry;
