@@ -43,7 +43,10 @@
 //! latest accepted step before t (the element's state, changed only in
 //! [`ForceElement::accept_step`], never inside Newton iterations or by
 //! rejected steps); without an accepted step before t (the start of a run)
-//! the rails are in static equilibrium. The contact has no damper of its own
+//! the rails are in static equilibrium. The outer iterations start from the
+//! creep forces of that same accepted step
+//! ([`railmbs_wheelrail::elastic_rail::solve_from`]), which halves their
+//! number without changing the solution. The contact has no damper of its own
 //! along the normal then (`normal_damping` must be 0: the rail dampers act
 //! in series with the Hertz spring). The Jacobian uses the Hertz stiffness in
 //! series with the support's K + C/h along the normal. Outputs per rail:
