@@ -133,7 +133,8 @@
 //! // parallel: F = c·s + f0 with d·(ẋ − ṡ) = c·s. The spring extension s is a
 //! // first-order state `<name>.s` integrated with q (Park's method only; RK4
 //! // refuses the model); it starts relaxed, s = 0.
-//! SeriesSpring(name: "yaw_damper", body1: "a", body2: "b", c: 5e6, d: 2e5, f0: 0, x0: 0.5),
+//! // No free length: the damper takes up any static length.
+//! SeriesSpring(name: "yaw_damper", body1: "a", body2: "b", c: 5e6, d: 2e5, f0: 0),
 //! ```
 //!
 //! As for `Spring`, x is the distance of the two points and a positive force

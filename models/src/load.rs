@@ -1757,7 +1757,6 @@ impl Cx<'_> {
                     c,
                     d,
                     f0,
-                    x0,
                     ..
                 } => {
                     let stiffness = self.expr(&w, "c", "c", c, false);
@@ -1774,7 +1773,6 @@ impl Cx<'_> {
                         stiffness,
                         damping,
                         preload: self.expr(&w, "f0", "f0", f0, false),
-                        free_length: self.expr(&w, "x0", "x0", x0, false),
                     }
                 }
                 RawForce::Linear6 {

@@ -186,8 +186,9 @@ pub enum ForceKind {
     /// Spring c in series with damper d between two points (paper Sect. 3.1),
     /// with a preload f0 in parallel: the spring's extension s is a
     /// first-order state variable integrated with q, and the tension is
-    /// F = c s + f0 = d (ẋ − ṡ) + f0, x the distance of the points (m) and
-    /// x − x0 = s + (damper extension). Positive F pulls the points together.
+    /// F = c s + f0 = d (ẋ − ṡ) + f0, x the distance of the points (m). No
+    /// free length: the damper takes up any static length change, so the
+    /// force depends on the motion only. Positive F pulls the points together.
     SeriesSpringDamper {
         body1: BodyRef,
         point1: [Expr; 3],
@@ -199,8 +200,6 @@ pub enum ForceKind {
         damping: Expr,
         /// N.
         preload: Expr,
-        /// Free length, m.
-        free_length: Expr,
     },
     /// Generalized linear 6×6 elastic and dissipative element (paper Sect. 3.2)
     /// between frame 1 on body 1 and frame 2 on body 2. The relative displacement

@@ -479,8 +479,6 @@ pub(crate) enum RawForce {
         d: Value,
         #[serde(default)]
         f0: Value,
-        #[serde(default)]
-        x0: Value,
     },
     Linear6 {
         name: String,

@@ -44,18 +44,22 @@ impl ForceKind {
                 preload,
                 free_length,
                 ..
+            } => {
+                point1.iter_mut().chain(point2.iter_mut()).for_each(&mut *f);
+                for e in [stiffness, damping, preload, free_length] {
+                    f(e);
+                }
             }
-            | ForceKind::SeriesSpringDamper {
+            ForceKind::SeriesSpringDamper {
                 point1,
                 point2,
                 stiffness,
                 damping,
                 preload,
-                free_length,
                 ..
             } => {
                 point1.iter_mut().chain(point2.iter_mut()).for_each(&mut *f);
-                for e in [stiffness, damping, preload, free_length] {
+                for e in [stiffness, damping, preload] {
                     f(e);
                 }
             }

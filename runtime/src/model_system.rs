@@ -240,7 +240,7 @@ impl ModelSystem {
 
     /// Evaluates `parts` at a state and returns the buffers (for outputs and
     /// tests). `q`, `v` are the system's (coordinates, then element states) or
-    /// the coordinates only.
+    /// the coordinates only (the element states of the last evaluation stay).
     pub fn evaluate(
         &mut self,
         t: f64,
@@ -248,6 +248,15 @@ impl ModelSystem {
         v: &[f64],
         parts: Parts,
     ) -> Result<&Evaluation, SimError> {
+        let (n, ns) = (self.n_coordinates, self.states.len());
+        if (q.len() != n && q.len() != n + ns) || v.len() != q.len() {
+            return Err(SimError::Other(format!(
+                "state of {} coordinates and {} velocities for a system of {n} coordinates \
+                 and {ns} element states",
+                q.len(),
+                v.len()
+            )));
+        }
         let (q, v) = self.take_states(q, v);
         self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
         Ok(&self.eval)
@@ -315,6 +324,10 @@ impl ModelSystem {
 impl MechanicalSystem for ModelSystem {
     fn dof(&self) -> usize {
         self.n_coordinates + self.states.len()
+    }
+
+    fn is_first_order(&self, i: usize) -> bool {
+        i >= self.n_coordinates && i < self.n_coordinates + self.states.len()
     }
 
     fn n_constraints(&self) -> usize {

@@ -31,6 +31,13 @@ pub trait MechanicalSystem {
     /// Number of generalized coordinates n.
     fn dof(&self) -> usize;
 
+    /// Whether coordinate `i` is a first-order state variable (a zero row and
+    /// column of M, its equation in row i of f). Any other zero row of M is
+    /// an error (a body without mass).
+    fn is_first_order(&self, _i: usize) -> bool {
+        false
+    }
+
     /// Number of scalar constraint equations nc (0 without closed loops).
     fn n_constraints(&self) -> usize {
         0
@@ -39,11 +46,12 @@ pub trait MechanicalSystem {
     /// Mass matrix M (n×n, symmetric) and f = Q − k (n). `mass` and `force`
     /// come sized; implementations overwrite them.
     ///
-    /// M is positive definite except for rows that are entirely zero: those
-    /// carry first-order state variables z (a spring in series with a damper)
-    /// whose equations r(q, q̇, z, ż) = 0 are the corresponding rows of f.
-    /// Park's method solves them with the equations of motion; explicit
-    /// integrators refuse such systems.
+    /// M is positive definite except for the rows of first-order state
+    /// variables z ([`MechanicalSystem::is_first_order`]; a spring in series
+    /// with a damper), which are entirely zero: their equations
+    /// r(q, q̇, z, ż) = 0 are the corresponding rows of f. Park's method
+    /// solves them with the equations of motion; explicit integrators refuse
+    /// such systems.
     fn dynamics(
         &mut self,
         t: f64,

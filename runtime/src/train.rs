@@ -278,6 +278,13 @@ impl MechanicalSystem for TrainSystem {
         self.ranges.last().map_or(0, |r| r.end)
     }
 
+    fn is_first_order(&self, i: usize) -> bool {
+        self.ranges
+            .iter()
+            .position(|r| r.contains(&i))
+            .is_some_and(|k| self.vehicles[k].is_first_order(i - self.ranges[k].start))
+    }
+
     fn n_constraints(&self) -> usize {
         self.constraint_ranges.last().map_or(0, |r| r.end)
     }

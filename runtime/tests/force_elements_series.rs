@@ -39,7 +39,7 @@ Model(
     ],
     forces: [
         SeriesSpring(name: "maxwell", body1: "ground", point1: (-1, 0, 0), body2: "mass",
-                     c: "c", d: "d", x0: 1),
+                     c: "c", d: "d"),
     ],
 )
 "#;
@@ -158,7 +158,7 @@ Model(
     ],
     forces: [
         SeriesSpring(name: "s", body1: "a", point1: (0, 0.1, 0), body2: "b", point2: (0.3, 0, 0),
-                     c: 2e4, d: 300, f0: 50, x0: 0.55),
+                     c: 2e4, d: 300, f0: 50),
     ],
 )
 "#;
@@ -277,4 +277,33 @@ fn scenario_writes_the_state_and_refuses_explicit_integration() {
         message.contains("maxwell.s") && message.contains("Park"),
         "{message}"
     );
+}
+
+/// Only declared element states may have zero mass-matrix rows: a body
+/// without mass is still a singular mass matrix, not a quasi-static
+/// coordinate.
+#[test]
+fn a_massless_body_is_refused_not_taken_for_a_state() {
+    let text = MAXWELL.replace(
+        r#"SeriesSpring(name: "maxwell", body1: "ground", point1: (-1, 0, 0), body2: "mass",
+                     c: "c", d: "d"),"#,
+        r#"Spring(name: "k", body1: "ground", point1: (-1, 0, 0), body2: "mass", c: "c", d: "d", x0: 1),"#,
+    );
+    let model = parse(&text);
+    // The model's default mass is checked when it is loaded; a scenario
+    // override is not.
+    let params = model
+        .parameter_values(&[], &[("m".to_string(), "0".to_string())])
+        .unwrap();
+    let (q0, v0) = model.initial_state(&params);
+    let mut sys =
+        ModelSystem::new(&model, Box::new(NumericEquations::new(&model)), params).unwrap();
+    assert!(sys.state_names().is_empty());
+    let settings = ParkSettings::with_tolerances(1e-8, 1e-9);
+    let e = integrate_park(&mut sys, &settings, 0.0, &q0, &v0, 0.1, |_, _, _, _| {
+        ControlFlow::Continue(())
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("singular"), "{e}");
 }

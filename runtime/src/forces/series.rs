@@ -25,7 +25,7 @@ use railmbs_models::{Expr, ForceKind};
 pub struct SeriesSpringDamper {
     name: String,
     pair: TwoPoint,
-    exprs: [Expr; 4],
+    exprs: [Expr; 3],
     /// Index of the spring extension s in the system's state vector.
     offset: usize,
     /// N/m.
@@ -34,8 +34,6 @@ pub struct SeriesSpringDamper {
     pub damping: f64,
     /// N.
     pub preload: f64,
-    /// m.
-    pub free_length: f64,
 }
 
 impl SeriesSpringDamper {
@@ -49,7 +47,6 @@ impl SeriesSpringDamper {
             stiffness,
             damping,
             preload,
-            free_length,
         } = kind
         else {
             unreachable!("SeriesSpringDamper::new takes a SeriesSpringDamper element")
@@ -57,17 +54,11 @@ impl SeriesSpringDamper {
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),
-            exprs: [
-                stiffness.clone(),
-                damping.clone(),
-                preload.clone(),
-                free_length.clone(),
-            ],
+            exprs: [stiffness.clone(), damping.clone(), preload.clone()],
             offset: 0,
             stiffness: 0.0,
             damping: 0.0,
             preload: 0.0,
-            free_length: 0.0,
         }
     }
 
@@ -92,11 +83,10 @@ impl ForceElement for SeriesSpringDamper {
 
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
         self.pair.set_parameters(params, &self.name)?;
-        let [c, d, f0, x0] = &self.exprs;
+        let [c, d, f0] = &self.exprs;
         self.stiffness = eval_scalar(c, params, &self.name, "stiffness c")?;
         self.damping = eval_scalar(d, params, &self.name, "damping d")?;
         self.preload = eval_scalar(f0, params, &self.name, "preload f0")?;
-        self.free_length = eval_scalar(x0, params, &self.name, "free length x0")?;
         if self.stiffness <= 0.0 || self.damping <= 0.0 {
             return Err(SimError::Other(format!(
                 "force element \"{}\": a spring in series with a damper needs c > 0 and d > 0, \

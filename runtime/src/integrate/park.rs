@@ -456,14 +456,14 @@ impl Work {
                 m[(i, j)] = self.mass[(i, j)];
             }
         }
-        // Rows without inertia (first-order element states, see
-        // `MechanicalSystem::dynamics`): their second derivative does not enter
-        // the equations; take it as zero.
+        // Rows of first-order states (`MechanicalSystem::is_first_order`):
+        // no inertia, their second derivative does not enter the equations;
+        // take it as zero. Any other zero row stays singular (and is refused).
         self.massless.clear();
         for i in 0..n {
-            let none = (0..n).all(|j| self.mass[(i, j)] == 0.0);
-            self.first_order[i] = none;
-            if none {
+            let first_order = system.is_first_order(i);
+            self.first_order[i] = first_order;
+            if first_order {
                 self.massless.push(i);
                 m[(i, i)] = 1.0;
             }
@@ -920,14 +920,17 @@ impl Work {
     /// and an unscaled test would chase it with ever smaller steps.
     fn error_norm(&self, ratio: f64, rtol: f64, atol: f64, h: f64) -> f64 {
         let mut sum = 0.0;
+        let mut terms = 0usize;
         let hs = h.min(1.0);
         for i in 0..self.n {
             let wq = atol + rtol * self.hq[0][i].abs().max(self.q[i].abs());
             let eq = ratio * (self.q[i] - self.qp[i]) / wq;
             if self.first_order[i] {
                 sum += eq * eq;
+                terms += 1;
                 continue;
             }
+            terms += 2;
             let mut wv = atol + rtol * self.hv[0][i].abs().max(self.v[i].abs());
             if self.constrained[i] {
                 wv /= hs;
@@ -935,7 +938,7 @@ impl Work {
             let ev = ratio * (self.v[i] - self.vp[i]) / wv;
             sum += eq * eq + ev * ev;
         }
-        (sum / (2 * self.n).max(1) as f64).sqrt()
+        (sum / terms.max(1) as f64).sqrt()
     }
 
     /// Makes the new point (t, q, v, a, λ) the most recent history entry.
