@@ -574,14 +574,13 @@ fn override_creep(model: &mut Model, law: &railmbs_models::CreepLawKind) -> bool
     found
 }
 
-/// True if the file's top-level value is a `Train(...)`.
+/// True if the file is a train (`Train(...)`, read as a scenario of either
+/// kind).
 fn is_train_file(path: &Path) -> bool {
-    std::fs::read_to_string(path).is_ok_and(|t| {
-        t.lines()
-            .map(str::trim)
-            .find(|l| !l.is_empty() && !l.starts_with("//"))
-            .is_some_and(|l| l.starts_with("Train("))
-    })
+    matches!(
+        railmbs_models::load_any_scenario(path),
+        Ok(railmbs_models::AnyScenario::Train(_))
+    )
 }
 
 /// Builds the engine of one vehicle's model.
@@ -627,6 +626,19 @@ fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>>
             override_creep(&mut m, law);
         }
         models.push(m);
+    }
+    if law.is_some()
+        && !models.iter().any(|m| {
+            m.forces
+                .iter()
+                .any(|f| matches!(f.kind, railmbs_models::ForceKind::WheelRail(_)))
+        })
+    {
+        return Err(format!(
+            "--creep: no vehicle of the train {} has a wheel–rail element",
+            args.model.display()
+        )
+        .into());
     }
     let mut numeric = EngineTimes::default();
     let mut symbolic = EngineTimes::default();

@@ -309,7 +309,8 @@ impl Expr {
         }
     }
 
-    /// Expression text that [`crate::parse_expr`] parses back to an expression
+    /// Expression text that [`crate::parse_expr`] (with local variables:
+    /// [`crate::parse_expr_vars`] with [`VAR_NAMES`]) parses back to an expression
     /// with the same value (the same tree up to literal signs). `names[i]` is the
     /// name of `Param(i)`; an index without a name is shown as `p<i>` (which
     /// re-parses only if such a name exists).

@@ -181,4 +181,15 @@ fn bad_surfaces_are_refused_with_the_element_named() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("bowl") && e.contains("x = 0.02"), "{e}");
+    // A kink (the slope of abs is 0/0 at 0) is not an error: the point on
+    // the ridge of the V-shaped surface z = 0.1|x| is pushed straight up.
+    let kink = BOWL.replace("(x^2 + y^2)/(2*R)", "0.1*abs(x)");
+    let model = parse(&kink).unwrap();
+    let (mut sys, mut q, v) = system(&model);
+    q[0] = 0.0;
+    q[2] = -1e-4;
+    let mut f = DVector::zeros(n);
+    sys.dynamics(0.0, &q, &v, &mut DMatrix::zeros(n, n), &mut f)
+        .unwrap();
+    assert!(f[2] > 0.0 && f[0] == 0.0 && f[1] == 0.0, "{f}");
 }

@@ -305,3 +305,43 @@ fn coasting_wheelset_loses_energy_only_through_its_contacts() {
         "energy balance off by {worst} J of {dissipated} J dissipated"
     );
 }
+
+/// The assessment judges Y/Q and ΣY as 2 m sliding means (EN 14363); a run
+/// shorter than the window (here 0.05 s at 30 m/s: 1.5 m) has no mean, and
+/// then its peaks carry the limits, so no run goes unjudged.
+#[test]
+fn short_runs_judge_the_peaks() {
+    let mut scenario =
+        railmbs_models::load_scenario(&model_path("scenarios/wheelset_on_springs_30.ron")).unwrap();
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let run = |scenario: &railmbs_models::Scenario| {
+        let dir = tempfile::tempdir().unwrap();
+        let summary = railmbs_runtime::simulate::run_scenario(
+            scenario,
+            &model,
+            Box::new(NumericEquations::new(&model)),
+            Some(&dir.path().join("out.csv")),
+            |_| {},
+        )
+        .unwrap();
+        assert!(summary.error.is_none(), "{:?}", summary.error);
+        summary.assessment
+    };
+    let limited = |rows: &[railmbs_runtime::forces::Assessment], q: &str| {
+        rows.iter()
+            .find(|a| a.quantity == q)
+            .unwrap_or_else(|| panic!("no row {q}"))
+            .limit
+            .is_some()
+    };
+    let long = run(&scenario);
+    assert!(limited(&long, "Y/Q left (2 m)") && !limited(&long, "Y/Q left peak"));
+    assert!(limited(&long, "|ΣY| (2 m)") && !limited(&long, "|ΣY| peak"));
+    scenario.end_time = 0.05;
+    let short = run(&scenario);
+    assert!(short.iter().all(|a| !a.quantity.contains("(2 m)")));
+    assert!(limited(&short, "Y/Q left peak") && limited(&short, "|ΣY| peak"));
+    // The wheel loads' minimum is reported (wheel unloading, 0 at a lift).
+    let q_min = short.iter().find(|a| a.quantity == "Q left min").unwrap();
+    assert!(q_min.max > 0.0);
+}

@@ -239,10 +239,14 @@ impl PointPlane {
         let local = self.to_plane(ctx, p) - self.origin;
         let xy = [local.x, local.y];
         let z = f.eval_vars(ctx.params, ctx.t, &xy);
-        let (sx, sy) = (
-            fx.eval_vars(ctx.params, ctx.t, &xy),
-            fy.eval_vars(ctx.params, ctx.t, &xy),
-        );
+        // A slope undefined where the height is defined is a kink (abs at 0,
+        // whose derivative x/|x| is 0/0 there): it counts as zero, the mean of
+        // a symmetric kink's two sides.
+        let slope = |e: &Expr| {
+            let v = e.eval_vars(ctx.params, ctx.t, &xy);
+            if v.is_finite() { v } else { 0.0 }
+        };
+        let (sx, sy) = (slope(fx), slope(fy));
         let n_local = Vector3::new(-sx, -sy, 1.0).normalize();
         let o_local = self.origin + Vector3::new(local.x, local.y, z);
         match self.plane_body {
@@ -395,8 +399,8 @@ impl ForceElement for PointPlane {
                     return Err(SimError::NonFinite {
                         t: ctx.t,
                         what: format!(
-                            "force element \"{}\": the surface or its slope is not finite under \
-                             point {k} (x = {} m, y = {} m in the surface frame)",
+                            "force element \"{}\": the surface is not defined under point {k} \
+                             (x = {} m, y = {} m in the surface frame)",
                             self.name, local.x, local.y
                         ),
                     });

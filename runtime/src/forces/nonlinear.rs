@@ -447,9 +447,9 @@ impl ForceElement for LoadFriction {
 pub struct Characteristic {
     interpolation: Interpolation,
     /// Deflections, m (increasing).
-    pub deflections: Vec<f64>,
+    deflections: Vec<f64>,
     /// Forces, N.
-    pub forces: Vec<f64>,
+    forces: Vec<f64>,
     /// Slopes at the rows (N/m) of the cubic interpolation.
     slopes: Vec<f64>,
 }
@@ -479,10 +479,19 @@ impl Characteristic {
         Ok(c)
     }
 
-    /// Value f(u) (N) and slope (N/m) at deflection u (m).
+    /// The rows' deflections (m) and forces (N).
+    pub fn rows(&self) -> (&[f64], &[f64]) {
+        (&self.deflections, &self.forces)
+    }
+
+    /// Value f(u) (N) and slope (N/m) at deflection u (m); zero for an
+    /// empty characteristic (`Default`, before any rows are set).
     pub fn eval(&self, u: f64) -> (f64, f64) {
         let xs = &self.deflections;
         let fs = &self.forces;
+        if xs.len() < 2 {
+            return (0.0, 0.0);
+        }
         // Segment k spans xs[k]..xs[k+1]; the end segments extend outwards.
         let k = match xs.partition_point(|&x| x <= u) {
             0 => 0,
@@ -569,7 +578,7 @@ pub struct Tabulated {
     x0_expr: Expr,
     interpolation: Interpolation,
     /// The characteristic f with the current parameters.
-    pub characteristic: Characteristic,
+    curve: Characteristic,
     /// N s/m.
     pub damping: f64,
     /// m.
@@ -599,7 +608,7 @@ impl Tabulated {
             damping_expr: damping.clone(),
             x0_expr: free_length.clone(),
             interpolation: *interpolation,
-            characteristic: Characteristic::default(),
+            curve: Characteristic::default(),
             damping: 0.0,
             free_length: 0.0,
         }
@@ -607,7 +616,7 @@ impl Tabulated {
 
     /// Table value f(u) (N) and slope (N/m) at deflection u (m).
     pub fn characteristic(&self, u: f64) -> (f64, f64) {
-        self.characteristic.eval(u)
+        self.curve.eval(u)
     }
 }
 
@@ -625,7 +634,7 @@ impl ForceElement for Tabulated {
                 eval_scalar(f, params, &self.name, &format!("table[{k}].force"))?,
             ));
         }
-        self.characteristic = Characteristic::new(&rows, self.interpolation)
+        self.curve = Characteristic::new(&rows, self.interpolation)
             .map_err(|e| SimError::Other(format!("force element \"{}\": {e}", self.name)))?;
         self.damping = eval_scalar(&self.damping_expr, params, &self.name, "damping d")?;
         self.free_length = eval_scalar(&self.x0_expr, params, &self.name, "free length x0")?;

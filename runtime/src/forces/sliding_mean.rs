@@ -6,9 +6,10 @@
 //!
 //! Samples (x, y) arrive with non-decreasing x (distance, m, or time, s); the
 //! signal between samples is taken as linear, and the mean over the window
-//! [x − L, x] is its exact integral over the window divided by L (the part of
-//! the window before the first sample counts the first value). Until the
-//! samples span a whole window there is no mean.
+//! [x − L, x] is its exact integral over the window divided by L. Until the
+//! samples span a whole window there is no mean. A sample at or before the
+//! last one's x replaces the samples it does not follow (a repeated step end;
+//! a new run starting over).
 
 use std::collections::VecDeque;
 
@@ -23,7 +24,8 @@ pub struct SlidingMean {
 }
 
 impl SlidingMean {
-    /// A window of `length` (> 0) in the unit of the samples' argument.
+    /// A window of `length` in the unit of the samples' argument; a length
+    /// that is not positive and finite gives no means.
     pub fn new(length: f64) -> Self {
         Self {
             length,
@@ -63,7 +65,7 @@ impl SlidingMean {
             self.samples.pop_front();
         }
         let (x0, y0) = self.samples[0];
-        if x0 > start {
+        if x0 > start || !(self.length > 0.0 && self.length.is_finite()) {
             return None;
         }
         // Remove the part of the first segment before the window start.

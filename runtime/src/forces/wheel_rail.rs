@@ -408,6 +408,8 @@ struct Maxima {
     sum_y: (f64, f64),
     /// max Q per side (N) and the time.
     q: [(f64, f64); 2],
+    /// min Q per side (N) and the time: wheel unloading, 0 when it lifts.
+    q_min: [(f64, f64); 2],
     /// Σ (Q_left + Q_right) over accepted steps and their count: the mean axle
     /// load for Prud'homme's limit.
     axle_load_sum: f64,
@@ -1262,6 +1264,9 @@ impl ForceElement for WheelRailContact {
             if q > m.q[side].0 {
                 m.q[side] = (q, ctx.t);
             }
+            if m.samples == 0 || q < m.q_min[side].0 {
+                m.q_min[side] = (q, ctx.t);
+            }
         }
         let sum_y = (loads[0].1 - loads[1].1).abs();
         if sum_y > m.sum_y.0 {
@@ -1326,11 +1331,14 @@ impl ForceElement for WheelRailContact {
         let axle = m.axle_load_sum / m.samples as f64;
         let mut rows = Vec::new();
         // EN 14363 judges Y/Q and ΣY as 2 m sliding means; the raw peaks are
-        // listed too (without a limit: a spike's sampled peak depends on the
-        // step sequence). Runs shorter than the window have no mean.
+        // listed too, without a limit (a spike's sampled peak depends on the
+        // step sequence) — except when the run was shorter than the window:
+        // then the peaks are judged. Where a wheel lifts (Q = 0) its Y/Q
+        // counts as 0 in the mean; the minimum Q rows show the lift.
         let means = self.means.as_deref();
         for (side, label) in [(0, "left"), (1, "right")] {
-            if let Some(mm) = means.filter(|mm| mm.max_y_over_q[side].0.is_finite()) {
+            let mean = means.filter(|mm| mm.max_y_over_q[side].0.is_finite());
+            if let Some(mm) = mean {
                 rows.push(super::Assessment {
                     element: self.name.clone(),
                     quantity: format!("Y/Q {label} (2 m)"),
@@ -1346,12 +1354,13 @@ impl ForceElement for WheelRailContact {
                 quantity: format!("Y/Q {label} peak"),
                 max: m.y_over_q[side].0,
                 time: m.y_over_q[side].1,
-                limit: None,
-                limit_name: "",
+                limit: if mean.is_some() { None } else { nadal },
+                limit_name: if mean.is_some() { "" } else { "Nadal" },
                 unit: "-",
             });
         }
-        if let Some(mm) = means.filter(|mm| mm.max_sum_y.0.is_finite()) {
+        let mean = means.filter(|mm| mm.max_sum_y.0.is_finite());
+        if let Some(mm) = mean {
             rows.push(super::Assessment {
                 element: self.name.clone(),
                 quantity: "|ΣY| (2 m)".into(),
@@ -1367,8 +1376,12 @@ impl ForceElement for WheelRailContact {
             quantity: "|ΣY| peak".into(),
             max: m.sum_y.0,
             time: m.sum_y.1,
-            limit: None,
-            limit_name: "",
+            limit: if mean.is_some() {
+                None
+            } else {
+                Some(prudhomme_limit(axle))
+            },
+            limit_name: if mean.is_some() { "" } else { "Prud'homme" },
             unit: "N",
         });
         for (side, label) in [(0, "left"), (1, "right")] {
@@ -1377,6 +1390,15 @@ impl ForceElement for WheelRailContact {
                 quantity: format!("Q {label}"),
                 max: m.q[side].0,
                 time: m.q[side].1,
+                limit: None,
+                limit_name: "",
+                unit: "N",
+            });
+            rows.push(super::Assessment {
+                element: self.name.clone(),
+                quantity: format!("Q {label} min"),
+                max: m.q_min[side].0,
+                time: m.q_min[side].1,
                 limit: None,
                 limit_name: "",
                 unit: "N",
