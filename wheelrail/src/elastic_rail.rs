@@ -709,20 +709,18 @@ fn lateral_creep_coefficient(
     let Ok(hc) = c.hertz.contact(nn) else {
         return 0.0;
     };
-    let Some(k) = KalkerCoefficients::interpolate_ab(hc.a, hc.b, material.nu) else {
-        return 0.0;
-    };
-    let gab = material.g * hc.a * hc.b;
-    let (f11, f22) = (gab * k.c11, gab * k.c22);
     let eta = c.creepages.eta - (vel[0] * t[0] + vel[1] * t[1]) / v_roll;
-    let linear = (f11 * c.creepages.xi).hypot(f22 * eta);
-    let actual = f.fx.hypot(f.fy);
-    let ratio = if linear > 0.0 {
-        (actual / linear).min(1.0)
-    } else {
-        1.0
-    };
-    f22 * ratio
+    KalkerCoefficients::saturated_slopes(
+        hc.a,
+        hc.b,
+        material.g,
+        material.nu,
+        c.creepages.xi,
+        eta,
+        f.fx,
+        f.fy,
+    )
+    .map_or(0.0, |(_, f22)| f22)
 }
 
 /// The Newton step −J⁻¹ r of a 2×2 system.

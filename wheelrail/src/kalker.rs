@@ -71,6 +71,34 @@ impl KalkerCoefficients {
         Self::interpolate_ab(a_over_b, 1.0, nu)
     }
 
+    /// The slopes of a saturating creep law for an approximate Jacobian:
+    /// Kalker's linear creep coefficients f11 = G a b C11 and f22 = G a b C22
+    /// (N), both scaled by the saturation ratio |F| / |F_linear| (≤ 1) of the
+    /// actual longitudinal and lateral forces `fx`, `fy` (N) at the creepages
+    /// `xi`, `eta`. `None` where [`KalkerCoefficients::interpolate_ab`] is.
+    #[allow(clippy::too_many_arguments)]
+    pub fn saturated_slopes(
+        a: f64,
+        b: f64,
+        shear_modulus: f64,
+        nu: f64,
+        xi: f64,
+        eta: f64,
+        fx: f64,
+        fy: f64,
+    ) -> Option<(f64, f64)> {
+        let k = Self::interpolate_ab(a, b, nu)?;
+        let gab = shear_modulus * a * b;
+        let (f11, f22) = (gab * k.c11, gab * k.c22);
+        let linear = (f11 * xi).hypot(f22 * eta);
+        let ratio = if linear > 0.0 {
+            (fx.hypot(fy) / linear).min(1.0)
+        } else {
+            1.0
+        };
+        Some((f11 * ratio, f22 * ratio))
+    }
+
     /// As [`KalkerCoefficients::interpolate`] from the semi-axes `a`
     /// (rolling direction) and `b` (positive, finite; one division).
     #[inline]
@@ -126,5 +154,29 @@ mod tests {
         assert!((c.c23 - 12.2).abs() < 1e-12);
         assert!(KalkerCoefficients::interpolate(-1.0, 0.3).is_none());
         assert!(KalkerCoefficients::interpolate(1.0, 0.6).is_none());
+    }
+
+    /// Below saturation (forces equal to the linear theory's) the slopes are
+    /// Kalker's G a b C11, G a b C22; forces at half the linear magnitude halve
+    /// both; a law never reports slopes above the linear ones.
+    #[test]
+    fn saturated_slopes_scale_with_the_saturation() {
+        let (a, b, g, nu) = (0.006, 0.004, 8.1e10, 0.28);
+        let k = KalkerCoefficients::interpolate_ab(a, b, nu).unwrap();
+        let (f11, f22) = (g * a * b * k.c11, g * a * b * k.c22);
+        let (xi, eta) = (1e-4, -2e-4);
+        let lin = (-f11 * xi, -f22 * eta);
+        let (s11, s22) =
+            KalkerCoefficients::saturated_slopes(a, b, g, nu, xi, eta, lin.0, lin.1).unwrap();
+        assert!((s11 - f11).abs() < 1e-9 * f11 && (s22 - f22).abs() < 1e-9 * f22);
+        let (h11, h22) =
+            KalkerCoefficients::saturated_slopes(a, b, g, nu, xi, eta, 0.5 * lin.0, 0.5 * lin.1)
+                .unwrap();
+        assert!((h11 - 0.5 * f11).abs() < 1e-9 * f11 && (h22 - 0.5 * f22).abs() < 1e-9 * f22);
+        let (m11, _) =
+            KalkerCoefficients::saturated_slopes(a, b, g, nu, xi, eta, 3.0 * lin.0, 3.0 * lin.1)
+                .unwrap();
+        assert!((m11 - f11).abs() < 1e-9 * f11);
+        assert!(KalkerCoefficients::saturated_slopes(a, b, g, 0.7, xi, eta, 0.0, 0.0).is_none());
     }
 }

@@ -946,17 +946,17 @@ impl WheelRailContact {
     ) -> Result<ContactState, SimError> {
         // Linear creep coefficients (Kalker), scaled by the saturation of the
         // actual forces, for the approximate Jacobian (paper Sect. 6).
-        let kc = KalkerCoefficients::interpolate_ab(patch.a, patch.b, self.c.poisson)
-            .ok_or_else(|| self.err("Poisson ratio outside Kalker's table"))?;
-        let gab = self.c.shear * patch.a * patch.b;
-        let (f11, f22) = (gab * kc.c11, gab * kc.c22);
-        let linear = (f11 * k.creepages.xi).hypot(f22 * k.creepages.eta);
-        let actual = forces.fx.hypot(forces.fy);
-        let ratio = if linear > 0.0 {
-            (actual / linear).min(1.0)
-        } else {
-            1.0
-        };
+        let (f11, f22) = KalkerCoefficients::saturated_slopes(
+            patch.a,
+            patch.b,
+            self.c.shear,
+            self.c.poisson,
+            k.creepages.xi,
+            k.creepages.eta,
+            forces.fx,
+            forces.fy,
+        )
+        .ok_or_else(|| self.err("Poisson ratio outside Kalker's table"))?;
         Ok(ContactState {
             point: k.point,
             ex: k.ex,
@@ -966,8 +966,8 @@ impl WheelRailContact {
             normal_stiffness: stiffness * k.cos_angle,
             creepages: k.creepages,
             forces,
-            f11: f11 * ratio,
-            f22: f22 * ratio,
+            f11,
+            f22,
             speed: k.speed,
             angle: k.angle,
             rail_y: k.rail_y,
