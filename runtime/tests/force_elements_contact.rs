@@ -357,7 +357,7 @@ Model(
 )
 "#;
 
-/// Outputs of all elements at (q, v): stop F, x, v; fr F, x, v, sliding; lf F, x, x2, sliding.
+/// Outputs of all elements at (q, v): stop F, x, v, E, P; fr F, x, v, sliding; lf F, x, x2, sliding.
 fn outputs(sys: &mut ModelSystem, q: &[f64], v: &[f64]) -> Vec<f64> {
     sys.evaluate(0.0, q, v, Parts::KINEMATICS).unwrap();
     let mut out = Vec::new();
@@ -389,7 +389,7 @@ fn element_forces_match_hand_computed_values() {
     let out = outputs(&mut sys, &[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0]);
     assert!(out.iter().all(|x| x.is_finite()), "{out:?}");
     assert_eq!(out[0], 0.0);
-    assert_eq!(out[3], 0.0);
+    assert_eq!(out[5], 0.0);
     let mut wrench_force = DVector::zeros(3);
     let mut mass = DMatrix::zeros(3, 3);
     sys.dynamics(
@@ -408,23 +408,23 @@ fn element_forces_match_hand_computed_values() {
     let (mut sys, ..) = system(&model, &[]);
     sys.accept_step(0.0, &[0.6, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     let out = outputs(&mut sys, &[0.63, 0.0, 0.0], &[0.0, 0.0, 0.0]);
-    assert!((out[3] - 30.0).abs() < 1e-9, "{out:?}");
-    assert_eq!(out[6], 0.0, "sticking");
+    assert!((out[5] - 30.0).abs() < 1e-9, "{out:?}");
+    assert_eq!(out[8], 0.0, "sticking");
     let out = outputs(&mut sys, &[0.7, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     assert!(
-        (out[3] - 50.0).abs() < 1e-9,
+        (out[5] - 50.0).abs() < 1e-9,
         "held at the static limit: {out:?}"
     );
     // Accepted beyond the limit: sliding at Fs = 40 N against the velocity.
     sys.accept_step(0.0, &[0.7, 0.0, 0.0], &[0.1, 0.0, 0.0]);
     let out = outputs(&mut sys, &[0.72, 0.0, 0.0], &[0.1, 0.0, 0.0]);
-    assert!((out[3] - 40.0).abs() < 1e-12 && out[6] == 1.0, "{out:?}");
+    assert!((out[5] - 40.0).abs() < 1e-12 && out[8] == 1.0, "{out:?}");
     // Sliding stops when the speed falls below V_STICK = 1e-4 m/s: sticks
     // with the current force f0 = 40 N stored at x0 = 0.72; 1 cm shorter the
     // tension is 40 − 1000·0.01 = 30 N.
     sys.accept_step(0.0, &[0.72, 0.0, 0.0], &[5e-5, 0.0, 0.0]);
     let out = outputs(&mut sys, &[0.71, 0.0, 0.0], &[0.0, 0.0, 0.0]);
-    assert!((out[3] - 30.0).abs() < 1e-9 && out[6] == 0.0, "{out:?}");
+    assert!((out[5] - 30.0).abs() < 1e-9 && out[8] == 0.0, "{out:?}");
 
     // Load-dependent friction from the unloaded state (x2 = 0: no friction
     // capacity), loading to u = 0.01: sliding branch F = c1 a/(c1 + a) u with
@@ -433,8 +433,8 @@ fn element_forces_match_hand_computed_values() {
     let (mut sys, ..) = system(&model, &[]);
     let out = outputs(&mut sys, &[0.51, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     let f = 3000.0 * 1250.0 / 4250.0 * 0.01;
-    assert!((out[7] - f).abs() < 1e-9, "{out:?}");
-    assert!((out[9] - 3000.0 * 0.01 / 4250.0).abs() < 1e-12);
+    assert!((out[9] - f).abs() < 1e-9, "{out:?}");
+    assert!((out[11] - 3000.0 * 0.01 / 4250.0).abs() < 1e-12);
 }
 
 #[test]
@@ -458,7 +458,7 @@ fn load_dependent_friction_loop_energy_is_independent_of_frequency() {
                 let v = a * 2.0 * PI * freq * (2.0 * PI * freq * t).cos();
                 let q = [0.5 + u, 0.0, 0.0];
                 let vel = [v, 0.0, 0.0];
-                let f = outputs(&mut sys, &q, &vel)[7];
+                let f = outputs(&mut sys, &q, &vel)[9];
                 sys.accept_step(t, &q, &vel);
                 if cycle == 2 {
                     if let Some((u0, f0)) = prev {

@@ -259,7 +259,9 @@ fn scenario_writes_the_state_and_refuses_explicit_integration() {
             "maxwell.F[N]",
             "maxwell.x[m]",
             "maxwell.v[m/s]",
-            "maxwell.s[m]"
+            "maxwell.s[m]",
+            "maxwell.E[J]",
+            "maxwell.P[W]"
         ]
     );
     assert_eq!(rows.len(), 6);

@@ -75,19 +75,24 @@ fn spline_reproduces_a_quadratic_inside_the_table() {
     }
 }
 
+/// A bump stop: clearance ±10 mm, then a progressive stop (m, N), as table
+/// text and as rows.
+const STOP_TABLE: &str =
+    "[(-0.03, -6e4), (-0.02, -1.5e4), (-0.01, 0), (0.01, 0), (0.02, 1.5e4), (0.03, 6e4)]";
+const STOP_ROWS: [(f64, f64); 6] = [
+    (-0.03, -6e4),
+    (-0.02, -1.5e4),
+    (-0.01, 0.0),
+    (0.01, 0.0),
+    (0.02, 1.5e4),
+    (0.03, 6e4),
+];
+
 #[test]
 fn spline_bump_stop_passes_the_rows_without_overshoot() {
     // Clearance ±10 mm, then a progressive stop.
-    let table =
-        "[(-0.03, -6e4), (-0.02, -1.5e4), (-0.01, 0), (0.01, 0), (0.02, 1.5e4), (0.03, 6e4)]";
-    let rows = [
-        (-0.03, -6e4),
-        (-0.02, -1.5e4),
-        (-0.01, 0.0),
-        (0.01, 0.0),
-        (0.02, 1.5e4),
-        (0.03, 6e4),
-    ];
+    let table = STOP_TABLE;
+    let rows = STOP_ROWS;
     let (mut sys, ..) = system(&model(table, "Spline"));
     for (u, f) in rows {
         assert!((characteristic(&mut sys, u) - f).abs() < 1e-9, "row {u}");
@@ -122,9 +127,7 @@ fn spline_bump_stop_passes_the_rows_without_overshoot() {
 
 #[test]
 fn spline_element_jacobian_equals_central_differences() {
-    let table =
-        "[(-0.03, -6e4), (-0.02, -1.5e4), (-0.01, 0), (0.01, 0), (0.02, 1.5e4), (0.03, 6e4)]";
-    let (mut sys, mut q, v) = system(&model(table, "Spline"));
+    let (mut sys, mut q, v) = system(&model(STOP_TABLE, "Spline"));
     q[0] = 0.5 + 0.0237; // inside a cubic segment
     let n = q.len();
     let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
@@ -148,4 +151,41 @@ fn spline_element_jacobian_equals_central_differences() {
             dq.column(j)
         );
     }
+}
+
+/// The characteristic's energy ∫₀ᵘ f is exact: for a straight-line table the
+/// areas of its trapezoids (and of the linear extensions), for the cubic the
+/// integral of the reproduced quadratic inside the table.
+#[test]
+fn characteristic_energy_is_the_integral_of_the_force() {
+    use railmbs_models::Interpolation;
+    use railmbs_runtime::forces::Characteristic;
+    let c = Characteristic::new(&STOP_ROWS, Interpolation::Linear).unwrap();
+    // Clearance: no energy; then the triangle and trapezoid areas.
+    assert_eq!(c.energy(0.005), 0.0);
+    let e = |u: f64| c.energy(u);
+    assert!((e(0.02) - 0.5 * 1.5e4 * 0.01).abs() < 1e-9);
+    assert!((e(0.03) - (75.0 + 0.5 * (1.5e4 + 6e4) * 0.01)).abs() < 1e-9);
+    // Beyond the table the end slope 4.5e6 N/m continues: f(0.04) = 1.05e5.
+    assert!((e(0.04) - (e(0.03) + 0.5 * (6e4 + 1.05e5) * 0.01)).abs() < 1e-9);
+    assert!((e(-0.02) - 0.5 * 1.5e4 * 0.01).abs() < 1e-9);
+    // Quadratic rows f = 1e4 u² (u = 0 … 0.05): interior segments are exact,
+    // so ∫ from 0.01 to 0.04 = 1e4 (0.04³ − 0.01³)/3.
+    let rows: Vec<(f64, f64)> = (0..6)
+        .map(|k| {
+            let u = 0.01 * k as f64;
+            (u, 1e4 * u * u)
+        })
+        .collect();
+    let q = Characteristic::new(&rows, Interpolation::Spline).unwrap();
+    let exact = 1e4 * (0.04f64.powi(3) - 0.01f64.powi(3)) / 3.0;
+    assert!(
+        (q.energy(0.04) - q.energy(0.01) - exact).abs() < 1e-12,
+        "{}",
+        q.energy(0.04) - q.energy(0.01)
+    );
+    // And the derivative of the energy is the force, at a point inside a segment.
+    let (u, h) = (0.0237, 1e-7);
+    let slope = (q.energy(u + h) - q.energy(u - h)) / (2.0 * h);
+    assert!((slope - q.eval(u).0).abs() < 1e-6 * q.eval(u).0);
 }

@@ -246,49 +246,7 @@ fn vehicle1_on_perfect_straight_track_stays_centred() {
 fn coasting_wheelset_loses_energy_only_through_its_contacts() {
     let scenario =
         railmbs_models::load_scenario(&model_path("scenarios/free_wheelset_klingel.ron")).unwrap();
-    let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let out = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
-    let (m, ixx, iyy, izz, load, g) = (1813.0, 1120.0, 112.0, 1120.0, 91300.0, 9.81);
-    let c = |n: &str| out.col(n);
-    let (t, z) = (c("time"), c("ws.z[m]"));
-    let (vx, vy, vz) = (c("ws.vx[m/s]"), c("ws.vy[m/s]"), c("ws.vz[m/s]"));
-    let (wx, wy, wz) = (c("ws.wx[rad/s]"), c("ws.wy[rad/s]"), c("ws.wz[rad/s]"));
-    let (rx, ry, rz) = (c("ws.rx[rad]"), c("ws.ry[rad]"), c("ws.rz[rad]"));
-    let elastic: Vec<f64> = c("contact.L.Eel [J]")
-        .iter()
-        .zip(c("contact.R.Eel [J]"))
-        .map(|(l, r)| l + r)
-        .collect();
-    let power: Vec<f64> = c("contact.L.P [W]")
-        .iter()
-        .zip(c("contact.R.P [W]"))
-        .map(|(l, r)| l + r)
-        .collect();
-    let energy = |i: usize| {
-        // ω in the body's axes: R = Rx(rx) Ry(ry) Rz(rz) (xyz Cardan angles).
-        let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), rx[i])
-            * nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), ry[i])
-            * nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), rz[i]);
-        let w = r.transpose() * nalgebra::Vector3::new(wx[i], wy[i], wz[i]);
-        0.5 * m * (vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i])
-            + 0.5 * (ixx * w.x * w.x + iyy * w.y * w.y + izz * w.z * w.z)
-            + (m * g + load) * z[i]
-            + elastic[i]
-    };
     // From t = 1 s (the vertical release transient has decayed) to the end.
-    let i0 = t.iter().position(|&x| x >= 1.0).unwrap();
-    let mut dissipated = 0.0;
-    let mut worst: f64 = 0.0;
-    for i in i0 + 1..t.len() {
-        dissipated += 0.5 * (power[i] + power[i - 1]) * (t[i] - t[i - 1]);
-        worst = worst.max((energy(i0) - energy(i) - dissipated).abs());
-    }
-    let lost = energy(i0) - energy(t.len() - 1);
-    println!(
-        "energy lost {lost:.3} J, dissipated at the contacts {dissipated:.3} J, \
-         largest gap on the way {worst:.3} J"
-    );
-    assert!(dissipated > 5.0, "dissipated {dissipated} J");
     // What is not exact: each time a wheel's contact point jumps across the
     // S1002 tread (about 10 mm, near the centred position), the table's gap —
     // linear in roll within a 2 mrad cell — and the lever arm of the jumped
@@ -296,13 +254,10 @@ fn coasting_wheelset_loses_energy_only_through_its_contacts() {
     // alternate in sign. Measured: 3 % net over 5 s, 6 % at worst on the way.
     // (Before the overswing was placed where the wheel's normal is the rail's,
     // the rolling did work against the normal force: 22 % net and growing.)
-    assert!(
-        (lost - dissipated).abs() < 0.05 * dissipated,
-        "energy lost {lost} J, dissipated {dissipated} J"
-    );
-    assert!(
-        worst < 0.08 * dissipated,
-        "energy balance off by {worst} J of {dissipated} J dissipated"
+    assert_balance(
+        "free wheelset",
+        energy_balance(scenario, 1.0),
+        (5.0, 0.05, 0.08),
     );
 }
 
@@ -344,4 +299,204 @@ fn short_runs_judge_the_peaks() {
     // The wheel loads' minimum is reported (wheel unloading, 0 at a lift).
     let q_min = short.iter().find(|a| a.quantity == "Q left min").unwrap();
     assert!(q_min.max > 0.0);
+}
+
+/// Mechanical energy (kinetic energy of all bodies, potential energy of
+/// gravity and of constant applied forces, the elastic energies the force
+/// elements report: outputs `E[J]`, `Eel [J]`) and the dissipated power the
+/// elements report (`P[W]`, `P [W]`) at every output row of a run of `model`.
+fn energy_and_dissipation(
+    model: &railmbs_models::Model,
+    params: &[f64],
+    out: &Table,
+) -> (Vec<f64>, Vec<f64>) {
+    use nalgebra::{Matrix3, Rotation3, Vector3};
+    use railmbs_models::{ForceKind, VectorFrame};
+    let c = |n: &str| out.col(n);
+    let rows = out.col("time").len();
+    let g = Vector3::from_iterator(model.gravity.iter().map(|e| e.eval(params, 0.0)));
+    let mut energy = vec![0.0; rows];
+    let mut poses = Vec::new();
+    for body in &model.bodies {
+        let n = &body.name;
+        let m = body.mass.eval(params, 0.0);
+        let i: Vec<f64> = body.inertia.iter().map(|e| e.eval(params, 0.0)).collect();
+        let inertia = Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2]);
+        let v3 = |a: &str, b: &str, cc: &str| {
+            let (x, y, z) = (
+                c(&format!("{n}.{a}")),
+                c(&format!("{n}.{b}")),
+                c(&format!("{n}.{cc}")),
+            );
+            (0..rows)
+                .map(|k| Vector3::new(x[k], y[k], z[k]))
+                .collect::<Vec<_>>()
+        };
+        let (r, v) = (
+            v3("x[m]", "y[m]", "z[m]"),
+            v3("vx[m/s]", "vy[m/s]", "vz[m/s]"),
+        );
+        let (w, ang) = (
+            v3("wx[rad/s]", "wy[rad/s]", "wz[rad/s]"),
+            v3("rx[rad]", "ry[rad]", "rz[rad]"),
+        );
+        let rot: Vec<Rotation3<f64>> = ang
+            .iter()
+            .map(|a| {
+                // xyz Cardan angles: R = Rx Ry Rz.
+                Rotation3::from_axis_angle(&Vector3::x_axis(), a.x)
+                    * Rotation3::from_axis_angle(&Vector3::y_axis(), a.y)
+                    * Rotation3::from_axis_angle(&Vector3::z_axis(), a.z)
+            })
+            .collect();
+        for k in 0..rows {
+            let wb = rot[k].transpose() * w[k];
+            energy[k] +=
+                0.5 * m * v[k].norm_squared() + 0.5 * wb.dot(&(inertia * wb)) - m * g.dot(&r[k]);
+        }
+        poses.push((r, rot));
+    }
+    // Constant forces given in SC0 (dead loads): potential −F·r of their point.
+    for f in &model.forces {
+        if let ForceKind::Applied {
+            body,
+            point,
+            force,
+            torque,
+            frame: VectorFrame::Global,
+        } = &f.kind
+        {
+            let ev = |e: &[railmbs_models::Expr; 3]| {
+                Vector3::new(
+                    e[0].eval(params, 0.0),
+                    e[1].eval(params, 0.0),
+                    e[2].eval(params, 0.0),
+                )
+            };
+            assert!(
+                [force, torque]
+                    .iter()
+                    .all(|e| !e.iter().any(|x| x.has_time()))
+                    && ev(torque) == Vector3::zeros(),
+                "{}: only constant forces have a potential",
+                f.name
+            );
+            let (r, rot) = &poses[*body];
+            for k in 0..rows {
+                energy[k] -= ev(force).dot(&(r[k] + rot[k] * ev(point)));
+            }
+        }
+    }
+    let mut power = vec![0.0; rows];
+    for h in &out.header {
+        if h.ends_with(".E[J]") || h.ends_with(".Eel [J]") {
+            for (e, x) in energy.iter_mut().zip(c(h)) {
+                *e += x;
+            }
+        }
+        if h.ends_with(".P[W]") || h.ends_with(".P [W]") {
+            for (p, x) in power.iter_mut().zip(c(h)) {
+                *p += x;
+            }
+        }
+    }
+    (energy, power)
+}
+
+/// Checks an energy balance (lost, dissipated, largest gap, J): at least
+/// `min` J dissipated, the net gap below `net` and the largest below `worst`
+/// (fractions of the dissipated energy).
+fn assert_balance(
+    name: &str,
+    (lost, dissipated, gap): (f64, f64, f64),
+    (min, net, worst): (f64, f64, f64),
+) {
+    println!(
+        "{name}: energy lost {lost:.3} J, dissipated {dissipated:.3} J, largest gap {gap:.3} J"
+    );
+    assert!(dissipated > min, "{name}: dissipated {dissipated} J");
+    assert!(
+        (lost - dissipated).abs() < net * dissipated,
+        "{name}: energy lost {lost} J, dissipated {dissipated} J"
+    );
+    assert!(
+        gap < worst * dissipated,
+        "{name}: largest gap {gap} J of {dissipated} J"
+    );
+}
+
+/// Runs `scenario` with all bodies and elements written and returns (energy
+/// lost, energy dissipated, largest gap between them on the way) from `t0`
+/// to the end ([`energy_and_dissipation`]).
+fn energy_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64, f64) {
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    scenario.output.bodies = vec!["*".into()];
+    scenario.output.forces = vec!["*".into()];
+    let params = scenario.parameter_values(&model).unwrap();
+    let out = run_to_table(&scenario, &model, Box::new(NumericEquations::new(&model)));
+    let t = out.col("time");
+    let (energy, power) = energy_and_dissipation(&model, &params, &out);
+    let i0 = t.iter().position(|&x| x >= t0).unwrap();
+    let (mut dissipated, mut worst) = (0.0, 0.0_f64);
+    for k in i0 + 1..t.len() {
+        dissipated += 0.5 * (power[k] + power[k - 1]) * (t[k] - t[k - 1]);
+        worst = worst.max((energy[i0] - energy[k] - dissipated).abs());
+    }
+    (energy[i0] - energy[t.len() - 1], dissipated, worst)
+}
+
+/// [`energy_balance`] of `scenario` coasting (speed hold off: `k_traction =
+/// c_traction = 0`) at 30 m/s on perfect straight track, written every 2 ms.
+fn coasting_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64, f64) {
+    let track = scenario.track.as_mut().unwrap();
+    track.file = model_path("tracks/straight.ron");
+    track.speed_profile.clear();
+    track.speed = 30.0;
+    for (name, value) in [("v0", "30"), ("k_traction", "0"), ("c_traction", "0")] {
+        scenario.parameters.push((name.into(), value.into()));
+    }
+    scenario.integrator = railmbs_models::IntegratorSpec::Park {
+        rtol: 1e-6,
+        atol: 1e-8,
+        max_step: 0.002,
+        initial_step: None,
+        jacobian: railmbs_models::JacobianKind::Analytic,
+    };
+    scenario.output.interval = 0.002;
+    energy_balance(scenario, t0)
+}
+
+/// A coasting vehicle loses energy only through damping and creep: the drop
+/// of its mechanical energy (kinetic energy of all bodies, potential energy of
+/// gravity and of constant dead loads, elastic energy of the suspension —
+/// ½δᵀCδ + W₀ᵀδ of the 6×6 elements, ∫f of the bump stops — and of the Hertz
+/// contacts) equals the integral of the power the dampers (δ̇ᵀDδ̇) and the
+/// wheel–rail contacts (creep and normal damper) report as dissipated.
+/// Manchester Vehicle 1's bogie (half the car body as a dead load) and the
+/// whole Vehicle 1, released 3 mm off centre at 30 m/s, speed hold off.
+///
+/// What is not exact: the contact points' jumps across the tread (see the
+/// free wheelset's balance), the suspension's small-rotation elastic energy,
+/// the trapezoidal rule over 2 ms rows. Measured over 2.5 s: bogie 36.3 J
+/// lost against 36.5 J dissipated (0.5 %), 1.5 % at worst on the way;
+/// Vehicle 1 48.8 J against 49.3 J (1.1 %), 1.1 % at worst. The bounds leave
+/// room for other step sequences.
+#[test]
+fn coasting_vehicles_lose_energy_only_through_damping_and_creep() {
+    let bogie = railmbs_models::load_scenario(&model_path("scenarios/bogie_critical.ron")).unwrap();
+    let mut bogie = bogie;
+    bogie.end_time = 3.0;
+    let mut vehicle =
+        railmbs_models::load_scenario(&model_path("scenarios/vehicle1_tc1.ron")).unwrap();
+    vehicle.end_time = 3.0;
+    for ws in ["Bogie1.WS1", "Bogie1.WS2", "Bogie2.WS1", "Bogie2.WS2"] {
+        vehicle.initial.push(railmbs_models::InitialOverride {
+            coordinate: format!("{ws}.ws.y"),
+            value: Some(0.003),
+            velocity: None,
+        });
+    }
+    for (name, scenario) in [("bogie", bogie), ("Vehicle 1", vehicle)] {
+        assert_balance(name, coasting_balance(scenario, 0.5), (10.0, 0.02, 0.03));
+    }
 }

@@ -196,12 +196,24 @@ impl ForceElement for LinearBipolar {
     }
 
     fn output_names(&self) -> Vec<String> {
-        vec!["F[N]".into(), "x[m]".into(), "v[m/s]".into()]
+        ["F[N]", "x[m]", "v[m/s]", "E[J]", "P[W]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
     }
 
+    /// Force, length, rate; the elastic energy ½c(x − x0)² + f0(x − x0) (J)
+    /// and the damper's dissipated power d ẋ² (W).
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let s = self.pair.state(ctx);
-        out.extend([self.force(&s), s.length, s.rate]);
+        let u = s.length - self.free_length;
+        out.extend([
+            self.force(&s),
+            s.length,
+            s.rate,
+            0.5 * self.stiffness * u * u + self.preload * u,
+            self.damping * s.rate * s.rate,
+        ]);
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {

@@ -104,6 +104,21 @@ impl Linear6 {
         )
     }
 
+    /// Elastic energy ½ δᵀ C δ + W₀ᵀ δ (J; the x term by the nonlinear
+    /// characteristic's integral when there is one; C symmetric, small
+    /// relative rotations) and the damper's dissipated power δ̇ᵀ D δ̇ (W).
+    fn energy_and_dissipation(&self, ctx: &ForceContext) -> (f64, f64) {
+        let (x, xd) = self.deflection(ctx);
+        let mut c = self.stiffness;
+        let mut energy = 0.0;
+        if let Some(f) = &self.longitudinal {
+            energy += f.energy(x[0]);
+            c[(0, 0)] = 0.0;
+        }
+        energy += 0.5 * x.dot(&(c * x)) + self.preload.dot(&x);
+        (energy, xd.dot(&(self.damping * xd)))
+    }
+
     fn wrench_in_frame1(&self, ctx: &ForceContext) -> Vector6<f64> {
         let (x, xd) = self.deflection(ctx);
         let mut elastic = self.stiffness * x;
@@ -149,15 +164,20 @@ impl ForceElement for Linear6 {
     }
 
     fn output_names(&self) -> Vec<String> {
-        ["Fx[N]", "Fy[N]", "Fz[N]", "Mx[N m]", "My[N m]", "Mz[N m]"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
+        [
+            "Fx[N]", "Fy[N]", "Fz[N]", "Mx[N m]", "My[N m]", "Mz[N m]", "E[J]", "P[W]",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
     }
 
+    /// The wrench body 1 exerts on body 2, in frame 1; the elastic energy
+    /// and the damper's dissipated power.
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
-        // The wrench body 1 exerts on body 2, in frame 1.
         out.extend(self.wrench_in_frame1(ctx).iter());
+        let (e, p) = self.energy_and_dissipation(ctx);
+        out.extend([e, p]);
     }
 
     /// W = −(C δ + D δ̇ + W₀): ∂W/∂δ = −C (with C₀₀ = f′(δx) for a nonlinear

@@ -529,6 +529,54 @@ impl Characteristic {
         (f, df)
     }
 
+    /// The work ∫₀ᵘ f(s) ds (J for N and m): the elastic energy of the
+    /// characteristic at deflection u, exact for the straight or cubic pieces
+    /// and the linear extensions.
+    pub fn energy(&self, u: f64) -> f64 {
+        self.integral_to(u) - self.integral_to(0.0)
+    }
+
+    /// ∫ f from the first row to u (negative below it).
+    fn integral_to(&self, u: f64) -> f64 {
+        let (xs, fs) = (&self.deflections, &self.forces);
+        let n = xs.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let f_at = |x: f64| self.eval(x).0;
+        if u <= xs[0] {
+            // Linear extension below the first row: trapezoid from u to x₀.
+            return -0.5 * (f_at(u) + fs[0]) * (xs[0] - u);
+        }
+        let mut total = 0.0;
+        for k in 0..n - 1 {
+            let (x0, x1) = (xs[k], xs[k + 1]);
+            if u <= x0 {
+                break;
+            }
+            let dx = x1 - x0;
+            let end = u.min(x1);
+            let s = (end - x0) / dx;
+            total += match self.interpolation {
+                Interpolation::Linear => 0.5 * (fs[k] + f_at(end)) * (end - x0),
+                Interpolation::Spline => {
+                    // ∫₀ˢ of the Hermite basis times Δx.
+                    let (m0, m1) = (self.slopes[k] * dx, self.slopes[k + 1] * dx);
+                    let (s2, s3, s4) = (s * s, s * s * s, s * s * s * s);
+                    dx * ((0.5 * s4 - s3 + s) * fs[k]
+                        + (0.25 * s4 - 2.0 / 3.0 * s3 + 0.5 * s2) * m0
+                        + (-0.5 * s4 + s3) * fs[k + 1]
+                        + (0.25 * s4 - s3 / 3.0) * m1)
+                }
+            };
+        }
+        if u > xs[n - 1] {
+            // Linear extension above the last row.
+            total += 0.5 * (fs[n - 1] + f_at(u)) * (u - xs[n - 1]);
+        }
+        total
+    }
+
     /// Fritsch–Carlson slopes: the three-point average inside (zero where the
     /// secants change sign or one vanishes), one-sided at the ends, then
     /// limited so that α² + β² ≤ 9 on every segment (α, β the end slopes over
@@ -650,21 +698,30 @@ impl ForceElement for Tabulated {
     }
 
     fn output_names(&self) -> Vec<String> {
-        ["F[N]", "x[m]", "v[m/s]"]
+        ["F[N]", "x[m]", "v[m/s]", "E[J]", "P[W]"]
             .iter()
             .map(|s| s.to_string())
             .collect()
     }
 
+    /// Force, length, rate; the elastic energy ∫ f (J) and the damper's
+    /// dissipated power d ẋ² (W).
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let s = self.pair.state(ctx);
-        let (f, _) = self.characteristic(s.length - self.free_length);
+        let u = s.length - self.free_length;
+        let (f, _) = self.characteristic(u);
         let f = if s.direction.is_some() {
             f + self.damping * s.rate
         } else {
             0.0
         };
-        out.extend([f, s.length, s.rate]);
+        out.extend([
+            f,
+            s.length,
+            s.rate,
+            self.curve.energy(u),
+            self.damping * s.rate * s.rate,
+        ]);
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {

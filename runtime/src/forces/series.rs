@@ -106,13 +106,27 @@ impl ForceElement for SeriesSpringDamper {
     }
 
     fn output_names(&self) -> Vec<String> {
-        vec!["F[N]".into(), "x[m]".into(), "v[m/s]".into(), "s[m]".into()]
+        ["F[N]", "x[m]", "v[m/s]", "s[m]", "E[J]", "P[W]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
     }
 
+    /// Force, length, rate, spring extension; the elastic energy ½ c s² + f0 x
+    /// (J, the preload's potential up to a constant) and the damper's
+    /// dissipated power (c s)²/d (W, the damper carries the spring's force).
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let s = self.pair.state(ctx);
         let (extension, _) = self.spring(ctx);
-        out.extend([self.force(&s, extension), s.length, s.rate, extension]);
+        let spring = self.stiffness * extension;
+        out.extend([
+            self.force(&s, extension),
+            s.length,
+            s.rate,
+            extension,
+            0.5 * spring * extension + self.preload * s.length,
+            spring * spring / self.damping,
+        ]);
     }
 
     fn state_count(&self) -> usize {
