@@ -56,6 +56,23 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
+    /// An empty summary of a run by `engine`, filled segment by segment.
+    pub(crate) fn new(engine: String) -> Self {
+        Self {
+            engine,
+            t_end: 0.0,
+            steps: 0,
+            rejected_steps: 0,
+            newton_iterations: 0,
+            jacobian_evaluations: 0,
+            dynamics_evaluations: 0,
+            cpu_time: 0.0,
+            rows: 0,
+            error: None,
+            assessment: Vec::new(),
+        }
+    }
+
     /// Adds the counts of one integration segment and records its end time.
     pub(crate) fn add_segment(&mut self, st: &IntegrationStats) {
         self.steps += st.steps;
@@ -916,19 +933,7 @@ pub fn run_scenario(
     };
     // Integrate from breakpoint to breakpoint (kinks of the track), restarting
     // with continuous absolute velocities at each.
-    let mut summary = RunSummary {
-        engine,
-        t_end: 0.0,
-        steps: 0,
-        rejected_steps: 0,
-        newton_iterations: 0,
-        jacobian_evaluations: 0,
-        dynamics_evaluations: 0,
-        cpu_time: 0.0,
-        rows: 0,
-        error: None,
-        assessment: Vec::new(),
-    };
+    let mut summary = RunSummary::new(engine);
     integrate_segments(
         &mut system,
         &scenario.integrator,

@@ -640,19 +640,7 @@ pub fn run_train(
         schedule.observe(t, q, v, a, &mut rec.sink.pending, &mut progress);
         ControlFlow::Continue(())
     };
-    let mut summary = RunSummary {
-        engine: names.join("+"),
-        t_end: 0.0,
-        steps: 0,
-        rejected_steps: 0,
-        newton_iterations: 0,
-        jacobian_evaluations: 0,
-        dynamics_evaluations: 0,
-        cpu_time: 0.0,
-        rows: 0,
-        error: None,
-        assessment: Vec::new(),
-    };
+    let mut summary = RunSummary::new(names.join("+"));
     // Each vehicle keeps its bodies' absolute velocities across a kink.
     integrate_segments(
         &mut system,

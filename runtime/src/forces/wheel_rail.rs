@@ -1329,80 +1329,51 @@ impl ForceElement for WheelRailContact {
         }
         let nadal = self.bound.as_ref().map(|b| b.nadal);
         let axle = m.axle_load_sum / m.samples as f64;
-        let mut rows = Vec::new();
         // EN 14363 judges Y/Q and ΣY as 2 m sliding means; the raw peaks are
         // listed too, without a limit (a spike's sampled peak depends on the
         // step sequence) — except when the run was shorter than the window:
         // then the peaks are judged. Where a wheel lifts (Q = 0) its Y/Q
         // counts as 0 in the mean; the minimum Q rows show the lift.
-        let means = self.means.as_deref();
-        for (side, label) in [(0, "left"), (1, "right")] {
-            let mean = means.filter(|mm| mm.max_y_over_q[side].0.is_finite());
-            if let Some(mm) = mean {
-                rows.push(super::Assessment {
-                    element: self.name.clone(),
-                    quantity: format!("Y/Q {label} (2 m)"),
-                    max: mm.max_y_over_q[side].0,
-                    time: mm.max_y_over_q[side].1,
-                    limit: nadal,
-                    limit_name: "Nadal",
-                    unit: "-",
-                });
-            }
-            rows.push(super::Assessment {
-                element: self.name.clone(),
-                quantity: format!("Y/Q {label} peak"),
-                max: m.y_over_q[side].0,
-                time: m.y_over_q[side].1,
-                limit: if mean.is_some() { None } else { nadal },
-                limit_name: if mean.is_some() { "" } else { "Nadal" },
-                unit: "-",
-            });
-        }
-        let mean = means.filter(|mm| mm.max_sum_y.0.is_finite());
-        if let Some(mm) = mean {
-            rows.push(super::Assessment {
-                element: self.name.clone(),
-                quantity: "|ΣY| (2 m)".into(),
-                max: mm.max_sum_y.0,
-                time: mm.max_sum_y.1,
-                limit: Some(prudhomme_limit(axle)),
-                limit_name: "Prud'homme",
-                unit: "N",
-            });
-        }
-        rows.push(super::Assessment {
+        let row = |quantity: String,
+                   (max, time): (f64, f64),
+                   limit: Option<(Option<f64>, &'static str)>,
+                   unit: &'static str| super::Assessment {
             element: self.name.clone(),
-            quantity: "|ΣY| peak".into(),
-            max: m.sum_y.0,
-            time: m.sum_y.1,
-            limit: if mean.is_some() {
-                None
-            } else {
-                Some(prudhomme_limit(axle))
-            },
-            limit_name: if mean.is_some() { "" } else { "Prud'homme" },
-            unit: "N",
-        });
+            quantity,
+            max,
+            time,
+            limit: limit.and_then(|l| l.0),
+            limit_name: limit.map_or("", |l| l.1),
+            unit,
+        };
+        let mut rows = Vec::new();
+        let means = self.means.as_deref();
+        let nadal = Some((nadal, "Nadal"));
+        let prudhomme = Some((Some(prudhomme_limit(axle)), "Prud'homme"));
         for (side, label) in [(0, "left"), (1, "right")] {
-            rows.push(super::Assessment {
-                element: self.name.clone(),
-                quantity: format!("Q {label}"),
-                max: m.q[side].0,
-                time: m.q[side].1,
-                limit: None,
-                limit_name: "",
-                unit: "N",
-            });
-            rows.push(super::Assessment {
-                element: self.name.clone(),
-                quantity: format!("Q {label} min"),
-                max: m.q_min[side].0,
-                time: m.q_min[side].1,
-                limit: None,
-                limit_name: "",
-                unit: "N",
-            });
+            let mean = means
+                .map(|mm| mm.max_y_over_q[side])
+                .filter(|v| v.0.is_finite());
+            if let Some(v) = mean {
+                rows.push(row(format!("Y/Q {label} (2 m)"), v, nadal, "-"));
+            }
+            let peak_limit = if mean.is_some() { None } else { nadal };
+            rows.push(row(
+                format!("Y/Q {label} peak"),
+                m.y_over_q[side],
+                peak_limit,
+                "-",
+            ));
+        }
+        let mean = means.map(|mm| mm.max_sum_y).filter(|v| v.0.is_finite());
+        if let Some(v) = mean {
+            rows.push(row("|ΣY| (2 m)".into(), v, prudhomme, "N"));
+        }
+        let peak_limit = if mean.is_some() { None } else { prudhomme };
+        rows.push(row("|ΣY| peak".into(), m.sum_y, peak_limit, "N"));
+        for (side, label) in [(0, "left"), (1, "right")] {
+            rows.push(row(format!("Q {label}"), m.q[side], None, "N"));
+            rows.push(row(format!("Q {label} min"), m.q_min[side], None, "N"));
         }
         rows
     }
