@@ -257,36 +257,13 @@ fn bounded_and_finite() {
     assert!(worst <= 1.0 + 1e-9, "{worst}");
 }
 
-/// Bad input is an error naming the input, never a panic or NaN; zero load or
-/// zero friction gives zero force.
+/// Zero load, zero friction or zero creepage give zero force (bad input is
+/// refused by name for every law in `creep.rs`'s `bad_input_is_named`).
 #[test]
-fn bad_input_is_named() {
+fn zero_load_friction_or_creepage_gives_zero_force() {
     let p = tread_patch();
     let c = cr(1e-3, 0.0, 0.0);
     let law = Polach::new();
-    for (q, cc, name) in [
-        (ContactPatch { a: -1.0, ..p }, c, "a"),
-        (ContactPatch { b: f64::NAN, ..p }, c, "b"),
-        (ContactPatch { g: 0.0, ..p }, c, "G"),
-        (ContactPatch { nu: 0.7, ..p }, c, "nu"),
-        (ContactPatch { mu: -0.1, ..p }, c, "mu"),
-        (
-            ContactPatch {
-                n: f64::INFINITY,
-                ..p
-            },
-            c,
-            "N",
-        ),
-        (p, cr(f64::NAN, 0.0, 0.0), "xi"),
-        (p, cr(0.0, f64::INFINITY, 0.0), "eta"),
-        (p, cr(0.0, 0.0, f64::NAN), "phi"),
-    ] {
-        match law.forces(&q, &cc) {
-            Err(CreepError::Input { name: n, .. }) => assert_eq!(n, name),
-            other => panic!("expected error for {name}, got {other:?}"),
-        }
-    }
     for q in [ContactPatch { n: 0.0, ..p }, ContactPatch { mu: 0.0, ..p }] {
         assert_eq!(law.forces(&q, &c).unwrap(), CreepForces::default());
     }
