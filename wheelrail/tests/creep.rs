@@ -553,7 +553,7 @@ fn extreme_inputs_stay_finite_and_bounded() {
         ),
         Box::new(Polach::new()),
     ];
-    let vals = [0.0, 1e-12, -3e-6, 1e-3, -0.05, 1.0];
+    let vals = [0.0, 1e-12, -3e-6, 1e-4, 1e-3, -4e-3, 0.02, -0.05, 1.0];
     for (a, b) in [(6e-3, 4e-3), (1e-4, 2e-2), (3e-2, 5e-4), (5e-3, 5e-3)] {
         for n in [1.0, 1e5] {
             let p = ContactPatch {
@@ -566,7 +566,7 @@ fn extreme_inputs_stay_finite_and_bounded() {
             };
             for &xi in &vals {
                 for &eta in &vals {
-                    for phi in [0.0, 1e-9, -0.2, 5.0, -100.0] {
+                    for phi in [0.0, 1e-9, -0.2, 0.5, 1.5, -3.0, 5.0, -100.0] {
                         let c = Creepages { xi, eta, phi };
                         for law in &laws {
                             let f = law.forces(&p, &c).unwrap();
