@@ -301,21 +301,8 @@ impl ModelSystem {
             let rows = &mut out.as_mut_slice()[n + offset..n + offset + count];
             self.forces[i].state_residuals(&ctx, rows);
         }
-        let jac = &self.eval.jacobians;
         for (j, w) in self.wrenches.iter().enumerate() {
-            let comps = [
-                w.force.x, w.force.y, w.force.z, w.moment.x, w.moment.y, w.moment.z,
-            ];
-            if comps.iter().all(|c| *c == 0.0) {
-                continue;
-            }
-            for (i, qi) in out.iter_mut().take(n).enumerate() {
-                let mut s = 0.0;
-                for (k, c) in comps.iter().enumerate() {
-                    s += jac[(6 * j + k, i)] * c;
-                }
-                *qi += s;
-            }
+            forces::add_generalized_force(&self.eval.jacobians, j, w, out.as_mut_slice());
         }
         Ok(())
     }

@@ -21,7 +21,7 @@
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
     Assessment, Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch,
-    Linear6, Wrench,
+    Linear6, Wrench, add_generalized_force,
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
@@ -323,19 +323,13 @@ impl MechanicalSystem for TrainSystem {
             let mut w = [Wrench::default(); 2];
             c.element.apply(&ctx, &mut w)?;
             for ((&k, &b), w) in c.vehicles.iter().zip(&c.bodies).zip(&w) {
-                let comps = [
-                    w.force.x, w.force.y, w.force.z, w.moment.x, w.moment.y, w.moment.z,
-                ];
-                let gamma = &self.vehicles[k].last_evaluation().jacobians;
                 let r = self.ranges[k].clone();
-                // Element states (after the coordinates) take no coupler force.
-                for (col, qi) in r.take(gamma.ncols()).enumerate() {
-                    let mut s = 0.0;
-                    for (row, x) in comps.iter().enumerate() {
-                        s += gamma[(6 * b + row, col)] * x;
-                    }
-                    force[qi] += s;
-                }
+                add_generalized_force(
+                    &self.vehicles[k].last_evaluation().jacobians,
+                    b,
+                    w,
+                    &mut force.as_mut_slice()[r],
+                );
             }
         }
         Ok(())

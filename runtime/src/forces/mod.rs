@@ -600,6 +600,26 @@ pub(crate) fn eval_scalar(
     }
 }
 
+/// Adds the generalized force Γ_bᵀ w of the wrench `w` on body `b` to `out`:
+/// `gamma` holds the stacked body Jacobians (rows 6b..6b+6 of body b, one
+/// column per coordinate); entries of `out` beyond its columns (first-order
+/// element states) take nothing.
+pub(crate) fn add_generalized_force(gamma: &DMatrix<f64>, b: usize, w: &Wrench, out: &mut [f64]) {
+    let comps = [
+        w.force.x, w.force.y, w.force.z, w.moment.x, w.moment.y, w.moment.z,
+    ];
+    if comps.iter().all(|c| *c == 0.0) {
+        return;
+    }
+    for (i, qi) in out.iter_mut().take(gamma.ncols()).enumerate() {
+        let mut s = 0.0;
+        for (k, c) in comps.iter().enumerate() {
+            s += gamma[(6 * b + k, i)] * c;
+        }
+        *qi += s;
+    }
+}
+
 /// Adds force `f` acting at the SC0 point `p` to the wrench of `body`.
 pub(crate) fn add_force(
     wrenches: &mut [Wrench],
