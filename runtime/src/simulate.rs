@@ -867,6 +867,24 @@ impl OutputSchedule {
         }
     }
 
+    /// [`OutputSchedule::observe`] into a CSV sink; asks the integrator to
+    /// stop once the sink has failed (its first error is kept).
+    pub(crate) fn observe_into(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        sink: &mut CsvSink,
+        progress: &mut impl FnMut(f64),
+    ) -> ControlFlow<()> {
+        if sink.failure.is_some() {
+            return ControlFlow::Break(());
+        }
+        self.observe(t, q, v, a, &mut sink.pending, progress);
+        ControlFlow::Continue(())
+    }
+
     /// The previous accepted step's end time, if any.
     pub(crate) fn last_time(&self) -> Option<f64> {
         self.prev.as_ref().map(|p| p.0)
@@ -923,13 +941,8 @@ pub fn run_scenario(
     let t_end = scenario.end_time;
     let mut schedule = OutputSchedule::new(t_end, scenario.output.interval, q0.len());
     let start = Instant::now();
-    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
-        let mut rec = recorder.borrow_mut();
-        if rec.sink.failure.is_some() {
-            return ControlFlow::Break(());
-        }
-        schedule.observe(t, q, v, a, &mut rec.sink.pending, &mut progress);
-        ControlFlow::Continue(())
+    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| {
+        schedule.observe_into(t, q, v, a, &mut recorder.borrow_mut().sink, &mut progress)
     };
     // Integrate from breakpoint to breakpoint (kinks of the track), restarting
     // with continuous absolute velocities at each.

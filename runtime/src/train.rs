@@ -33,7 +33,7 @@ use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model, TrainCoupler, TrainScenario};
 use std::cell::RefCell;
-use std::ops::{ControlFlow, Range};
+use std::ops::Range;
 use std::path::Path;
 use std::rc::Rc;
 use std::time::Instant;
@@ -626,13 +626,8 @@ pub fn run_train(
     let t_end = train.end_time;
     let mut schedule = OutputSchedule::new(t_end, train.output.interval, q0.len());
     let start = Instant::now();
-    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| -> ControlFlow<()> {
-        let mut rec = recorder.borrow_mut();
-        if rec.sink.failure.is_some() {
-            return ControlFlow::Break(());
-        }
-        schedule.observe(t, q, v, a, &mut rec.sink.pending, &mut progress);
-        ControlFlow::Continue(())
+    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| {
+        schedule.observe_into(t, q, v, a, &mut recorder.borrow_mut().sink, &mut progress)
     };
     let mut summary = RunSummary::new(names.join("+"));
     // Each vehicle keeps its bodies' absolute velocities across a kink.

@@ -390,8 +390,14 @@ impl ForceElement for PointPlane {
 
     fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
         let body = self.body();
-        if self.surface.is_some() {
-            for (k, att) in self.points.iter().enumerate() {
+        for (k, att) in self.points.iter().enumerate() {
+            if let Some(e) = self.evaluate(ctx, k) {
+                let f = e.normal_force * e.n + e.ft;
+                add_force(wrenches, ctx, body, &e.p, &f);
+                add_force(wrenches, ctx, self.plane_body, &e.p, &(-f));
+            } else if self.surface.is_some() {
+                // No contact, or a surface undefined under the point (which
+                // `evaluate` cannot tell apart): only then look again.
                 let p = att.position(ctx);
                 let (o, n) = self.contact_plane(ctx, &p);
                 if !(o.iter().chain(n.iter()).all(|x| x.is_finite())) {
@@ -405,13 +411,6 @@ impl ForceElement for PointPlane {
                         ),
                     });
                 }
-            }
-        }
-        for k in 0..self.points.len() {
-            if let Some(e) = self.evaluate(ctx, k) {
-                let f = e.normal_force * e.n + e.ft;
-                add_force(wrenches, ctx, body, &e.p, &f);
-                add_force(wrenches, ctx, self.plane_body, &e.p, &(-f));
             }
         }
         Ok(())
