@@ -453,10 +453,7 @@ impl Cx<'_> {
     fn parameter_names<'r>(&mut self, raw: &'r RawModel) -> Vec<&'r ParamValue> {
         let mut kept = Vec::new();
         for (i, (name, pv)) in raw.parameters.0.iter().enumerate() {
-            let nth = raw.parameters.0[..i]
-                .iter()
-                .filter(|(n, _)| n == name)
-                .count();
+            let nth = occurrence(&raw.parameters.0, i, |p| &p.0);
             let w = Where::Param(name.clone(), nth);
             if !is_identifier(name) {
                 self.err(
@@ -623,7 +620,7 @@ impl Cx<'_> {
     fn macros(&mut self, raw: &RawModel, subs: &[Sub]) -> Vec<Macro> {
         let mut out: Vec<Macro> = Vec::new();
         for (i, (name, assigns)) in raw.macros.0.iter().enumerate() {
-            let nth = raw.macros.0[..i].iter().filter(|(n, _)| n == name).count();
+            let nth = occurrence(&raw.macros.0, i, |m| &m.0);
             let w = Where::Macro(name.clone(), nth);
             if out.iter().any(|m| &m.name == name) {
                 self.err(&w, None, None, "duplicate macro name".into());
@@ -705,7 +702,7 @@ impl Cx<'_> {
         }
         let mut valid = vec![true; n];
         for (i, b) in raw.bodies.iter().enumerate() {
-            let nth = raw.bodies[..i].iter().filter(|o| o.name == b.name).count();
+            let nth = occurrence(&raw.bodies, i, |o| &o.name);
             let w = Where::Elem(BODY, b.name.clone(), nth);
             if b.name.is_empty() {
                 self.err(
@@ -1493,10 +1490,7 @@ impl Cx<'_> {
     fn cut_joints(&mut self, raw: &RawModel, lookup: &Lookup, subs: &[Sub]) -> Vec<CutJoint> {
         let mut out: Vec<CutJoint> = Vec::new();
         for (i, c) in raw.cut_joints.iter().enumerate() {
-            let nth = raw.cut_joints[..i]
-                .iter()
-                .filter(|o| o.name == c.name)
-                .count();
+            let nth = occurrence(&raw.cut_joints, i, |o| &o.name);
             let w = Where::Elem(CUT, c.name.clone(), nth);
             if nth > 0 {
                 self.err(&w, Some("name"), None, "duplicate cut joint name".into());
@@ -1710,7 +1704,7 @@ impl Cx<'_> {
         let mut out = Vec::new();
         for (i, f) in raw.forces.iter().enumerate() {
             let name = f.name();
-            let nth = raw.forces[..i].iter().filter(|o| o.name() == name).count();
+            let nth = occurrence(&raw.forces, i, |o| o.name());
             let w = Where::Elem(FORCE, name.to_string(), nth);
             if nth > 0 {
                 self.err(&w, Some("name"), None, "duplicate force name".into());
@@ -2207,10 +2201,7 @@ impl Cx<'_> {
             }
         }
         for (i, (name, c)) in raw.connections.0.iter().enumerate() {
-            let nth = raw.connections.0[..i]
-                .iter()
-                .filter(|(n, _)| n == name)
-                .count();
+            let nth = occurrence(&raw.connections.0, i, |c| &c.0);
             let w = Where::Conn(name.clone(), nth);
             if !is_identifier(name) {
                 self.err(
@@ -2595,4 +2586,11 @@ pub(crate) fn sym3_eigenvalues(a: [[f64; 3]; 3]) -> [f64; 3] {
     };
     ev.sort_by(f64::total_cmp);
     ev
+}
+
+/// How many items before `items[i]` carry its name (`name_of`): which
+/// occurrence of a repeated name `items[i]` is, to locate it in the file.
+fn occurrence<T>(items: &[T], i: usize, name_of: impl Fn(&T) -> &str) -> usize {
+    let name = name_of(&items[i]);
+    items[..i].iter().filter(|o| name_of(o) == name).count()
 }

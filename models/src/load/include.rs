@@ -228,10 +228,7 @@ impl<'a> Cx<'a> {
         let mut subs = Vec::new();
         let dir = self.file.parent().unwrap_or(Path::new("")).to_path_buf();
         for (i, rs) in raw.subsystems.iter().enumerate() {
-            let nth = raw.subsystems[..i]
-                .iter()
-                .filter(|o| o.name == rs.name)
-                .count();
+            let nth = super::occurrence(&raw.subsystems, i, |o| &o.name);
             let w = Where::Elem(SUBSYSTEM, rs.name.clone(), nth);
             if !is_identifier(&rs.name) || rs.name.contains('.') {
                 self.err(
