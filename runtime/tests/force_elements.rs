@@ -6,60 +6,16 @@
 //! (an independent computation), from closed-form solutions, or from runs with
 //! the finite-difference Jacobian, never from the analytic Jacobian under test.
 
+mod common;
+
+use common::*;
 use std::ops::ControlFlow;
 use std::path::Path;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use railmbs_models::Model;
+use railmbs_runtime::MechanicalSystem;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
-
-fn parse(text: &str) -> Model {
-    railmbs_models::parse_model(text, Path::new("test.ron")).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn system(model: &Model) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    let params = model
-        .parameter_values(&[], &[])
-        .unwrap_or_else(|e| panic!("{e}"));
-    let (q0, v0) = model.initial_state(&params);
-    let sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
-    (sys, q0, v0)
-}
-
-/// Central differences of f = Q − k from `dynamics`, with respect to q
-/// (`wrt_v` false) or q̇.
-fn central_difference(sys: &mut ModelSystem, q: &[f64], v: &[f64], wrt_v: bool) -> DMatrix<f64> {
-    let n = q.len();
-    let mut out = DMatrix::zeros(n, n);
-    let mut mass = DMatrix::zeros(n, n);
-    let mut fp = DVector::zeros(n);
-    let mut fm = DVector::zeros(n);
-    for j in 0..n {
-        let h = 1e-6;
-        let (mut qp, mut vp) = (q.to_vec(), v.to_vec());
-        let (mut qm, mut vm) = (q.to_vec(), v.to_vec());
-        if wrt_v {
-            vp[j] += h;
-            vm[j] -= h;
-        } else {
-            qp[j] += h;
-            qm[j] -= h;
-        }
-        sys.dynamics(0.0, &qp, &vp, &mut mass, &mut fp).unwrap();
-        sys.dynamics(0.0, &qm, &vm, &mut mass, &mut fm).unwrap();
-        out.set_column(j, &((&fp - &fm) / (2.0 * h)));
-    }
-    out
-}
-
-fn analytic(sys: &mut ModelSystem, q: &[f64], v: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
-    let n = q.len();
-    let mut dq = DMatrix::zeros(n, n);
-    let mut dv = DMatrix::zeros(n, n);
-    assert!(sys.force_jacobian(0.0, q, v, &mut dq, &mut dv).unwrap());
-    (dq, dv)
-}
 
 /// Relative difference in the max norm.
 fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
@@ -102,10 +58,10 @@ Model(
 #[test]
 fn assembled_jacobian_equals_central_differences_for_translating_bodies() {
     let model = parse(TRANSLATING);
-    let (mut sys, q, v) = system(&model);
+    let (mut sys, q, v) = system(&model, &[]);
     let (dq, dv) = analytic(&mut sys, &q, &v);
-    let fq = central_difference(&mut sys, &q, &v, false);
-    let fv = central_difference(&mut sys, &q, &v, true);
+    let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
+    let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // Central differences with h = 1e-6 of forces ~1e3 N: truncation
     // ~h²·f''' ≈ 1e-9 relative, rounding ~ε·|f|/h ≈ 1e-10·|f|: 1e-6 is ample.
     assert!(rel_diff(&dq, &fq) < 1e-6, "∂f/∂q:\n{dq}\nvs\n{fq}");
@@ -142,11 +98,11 @@ Model(
 #[test]
 fn assembled_jacobian_is_exact_for_rotating_bodies_at_zero_force() {
     let model = parse(ROTATING);
-    let (mut sys, q, v) = system(&model);
+    let (mut sys, q, v) = system(&model, &[]);
     assert!(v.iter().all(|x| *x == 0.0));
     let (dq, dv) = analytic(&mut sys, &q, &v);
-    let fq = central_difference(&mut sys, &q, &v, false);
-    let fv = central_difference(&mut sys, &q, &v, true);
+    let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
+    let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // Same difference accuracy as above; rotations enter through sin/cos of
     // O(1) angles, which the O(h²) truncation does not change.
     assert!(rel_diff(&dq, &fq) < 1e-6, "∂f/∂q:\n{dq}\nvs\n{fq}");
@@ -159,7 +115,7 @@ fn systems_without_force_elements_fall_back_to_differences() {
         r#"Model(name: "p", bodies: [Body(name: "a", mass: 1, inertia: (ixx: 1, iyy: 1, izz: 1),
             joint: Revolute(parent: "ground", axis: X, to_com: (0, 0, -1)))])"#,
     );
-    let (mut sys, q, v) = system(&model);
+    let (mut sys, q, v) = system(&model, &[]);
     let mut dq = DMatrix::zeros(1, 1);
     let mut dv = DMatrix::zeros(1, 1);
     assert!(!sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap());
@@ -177,7 +133,7 @@ fn spring_mass() -> Model {
 fn park_with_the_analytic_jacobian_matches_differences_with_fewer_evaluations() {
     let model = spring_mass();
     let run = |kind: JacobianKind| {
-        let (mut sys, q0, v0) = system(&model);
+        let (mut sys, q0, v0) = system(&model, &[]);
         let settings = ParkSettings {
             jacobian: kind,
             ..ParkSettings::with_tolerances(1e-8, 1e-10)

@@ -6,32 +6,17 @@
 //! the damped oscillator's decrement (paper Table 1), force values computed
 //! by hand, and the local Jacobians against central differences.
 
+mod common;
+
+use common::*;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 use std::path::Path;
 
 use nalgebra::{DMatrix, DVector};
-use railmbs_models::Model;
 use railmbs_runtime::forces::contact_stiffness_damping;
 use railmbs_runtime::integrate::{IntegrationStats, JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations, Parts};
-
-fn parse(text: &str) -> Model {
-    railmbs_models::parse_model(text, Path::new("test.ron")).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn system(model: &Model, overrides: &[(&str, String)]) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    let ov: Vec<(String, String)> = overrides
-        .iter()
-        .map(|(a, b)| (a.to_string(), b.clone()))
-        .collect();
-    let params = model
-        .parameter_values(&[], &ov)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let (q0, v0) = model.initial_state(&params);
-    let sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
-    (sys, q0, v0)
-}
+use railmbs_runtime::{MechanicalSystem, ModelSystem, Parts};
 
 /// An accepted state (t, q, v).
 type State = (f64, Vec<f64>, Vec<f64>);
@@ -502,28 +487,6 @@ fn load_dependent_friction_loop_energy_is_independent_of_frequency() {
 // Local Jacobians of the new elements against central differences
 // ---------------------------------------------------------------------------
 
-fn central_difference(sys: &mut ModelSystem, q: &[f64], v: &[f64], wrt_v: bool) -> DMatrix<f64> {
-    let n = q.len();
-    let mut out = DMatrix::zeros(n, n);
-    let mut mass = DMatrix::zeros(n, n);
-    let (mut fp, mut fm) = (DVector::zeros(n), DVector::zeros(n));
-    for j in 0..n {
-        let h = 1e-6;
-        let (mut qp, mut vp, mut qm, mut vm) = (q.to_vec(), v.to_vec(), q.to_vec(), v.to_vec());
-        if wrt_v {
-            vp[j] += h;
-            vm[j] -= h;
-        } else {
-            qp[j] += h;
-            qm[j] -= h;
-        }
-        sys.dynamics(0.0, &qp, &vp, &mut mass, &mut fp).unwrap();
-        sys.dynamics(0.0, &qm, &vm, &mut mass, &mut fm).unwrap();
-        out.set_column(j, &((&fp - &fm) / (2.0 * h)));
-    }
-    out
-}
-
 /// Two translating bodies: contact points on `a` against a tilted plane on
 /// `b`, and the bipolar elements between them. Γ is constant, so the local
 /// Jacobians mapped by the point Jacobians are the exact derivatives.
@@ -574,8 +537,8 @@ fn new_elements_local_jacobians_equal_central_differences() {
         let n = q.len();
         let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
         assert!(sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap());
-        let fq = central_difference(&mut sys, &q, &v, false);
-        let fv = central_difference(&mut sys, &q, &v, true);
+        let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
+        let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
         // h = 1e-6 on forces ≤ ~1e3 N: rounding ε|f|/h ≈ 2e-7, truncation
         // negligible for these piecewise-smooth laws: relative 1e-6 of the
         // largest entry.

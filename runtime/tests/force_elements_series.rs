@@ -3,28 +3,14 @@
 //! the closed-form solution of the linear third-order system, the energy
 //! balance of the damper, and its Jacobian against central differences.
 
+mod common;
+
+use common::*;
 use std::ops::ControlFlow;
-use std::path::Path;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use railmbs_models::Model;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
-
-fn parse(text: &str) -> Model {
-    railmbs_models::parse_model(text, Path::new("test.ron")).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// The system and its initial q, q̇ (element states appended).
-fn system(model: &Model) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    let params = model
-        .parameter_values(&[], &[])
-        .unwrap_or_else(|e| panic!("{e}"));
-    let (q0, v0) = model.initial_state(&params);
-    let mut sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
-    let (q0, v0) = sys.initial_state(0.0, &q0, &v0).unwrap();
-    (sys, q0, v0)
-}
+use railmbs_runtime::{MechanicalSystem, NumericEquations};
 
 /// A mass m on a line, tied to the ground by a spring c in series with a
 /// damper d, started with velocity v0 from the relaxed state.
@@ -69,7 +55,7 @@ fn maxwell_element_follows_the_closed_form_response() {
     let a = Matrix3::new(0.0, 1.0, 0.0, 0.0, 0.0, -c / m, 0.0, 1.0, -c / d);
     let y0 = Vector3::new(0.0, v0, 0.0);
     let model = parse(MAXWELL);
-    let (mut sys, q0, v0s) = system(&model);
+    let (mut sys, q0, v0s) = system(&model, &[]);
     assert_eq!(sys.state_names(), ["maxwell.s"]);
     assert_eq!((q0.len(), v0s.clone()), (2, vec![v0, v0]));
     // Largest deviation of (x, s) from the closed form, and steps, at a tolerance.
@@ -112,7 +98,7 @@ fn maxwell_element_dissipates_its_damper_work() {
     // carrying the spring force F = c s at the rate ẋ − ṡ = F/d.
     let (m, c, d, v0) = (1.0, 1e4, 200.0, 1.0);
     let model = parse(MAXWELL);
-    let (mut sys, q0, v0s) = system(&model);
+    let (mut sys, q0, v0s) = system(&model, &[]);
     let settings = ParkSettings {
         max_step: 2e-4,
         jacobian: JacobianKind::Analytic,
@@ -166,39 +152,20 @@ Model(
 #[test]
 fn series_element_jacobian_equals_central_differences() {
     let model = parse(SKEW);
-    let (mut sys, mut q, mut v) = system(&model);
+    let (mut sys, mut q, mut v) = system(&model, &[]);
     let n = q.len();
     assert_eq!(n, 7);
     // A loaded spring and a state rate off its equilibrium value.
     q[6] = 0.004;
     v[6] = -0.2;
-    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-    assert!(sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap());
+    let (dq, dv) = analytic(&mut sys, &q, &v);
     let mut mass = DMatrix::zeros(n, n);
     let mut f = DVector::zeros(n);
     sys.dynamics(0.0, &q, &v, &mut mass, &mut f).unwrap();
     // No inertia on the state row.
     assert!((0..n).all(|j| mass[(6, j)] == 0.0 && mass[(j, 6)] == 0.0));
-    let mut diff = |wrt_v: bool| {
-        let mut out = DMatrix::zeros(n, n);
-        let (mut fp, mut fm) = (DVector::zeros(n), DVector::zeros(n));
-        for j in 0..n {
-            let h = 1e-6;
-            let (mut qp, mut vp, mut qm, mut vm) = (q.clone(), v.clone(), q.clone(), v.clone());
-            let (p, m) = if wrt_v {
-                (&mut vp[j], &mut vm[j])
-            } else {
-                (&mut qp[j], &mut qm[j])
-            };
-            *p += h;
-            *m -= h;
-            sys.dynamics(0.0, &qp, &vp, &mut mass, &mut fp).unwrap();
-            sys.dynamics(0.0, &qm, &vm, &mut mass, &mut fm).unwrap();
-            out.set_column(j, &((&fp - &fm) / (2.0 * h)));
-        }
-        out
-    };
-    let (fq, fv) = (diff(false), diff(true));
+    let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
+    let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // Translating bodies: Γ is constant and the element's local Jacobian is
     // exact, so only difference rounding (ε|f|/h ≈ 1e-7 relative) remains.
     let rel = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() / b.amax();
@@ -294,12 +261,7 @@ fn a_massless_body_is_refused_not_taken_for_a_state() {
     let model = parse(&text);
     // The model's default mass is checked when it is loaded; a scenario
     // override is not.
-    let params = model
-        .parameter_values(&[], &[("m".to_string(), "0".to_string())])
-        .unwrap();
-    let (q0, v0) = model.initial_state(&params);
-    let mut sys =
-        ModelSystem::new(&model, Box::new(NumericEquations::new(&model)), params).unwrap();
+    let (mut sys, q0, v0) = system(&model, &[("m", "0".into())]);
     assert!(sys.state_names().is_empty());
     let settings = ParkSettings::with_tolerances(1e-8, 1e-9);
     let e = integrate_park(&mut sys, &settings, 0.0, &q0, &v0, 0.1, |_, _, _, _| {

@@ -4,25 +4,15 @@
 //! surface gives the same forces and Jacobians as the equivalent point–plane
 //! contact; bad surfaces give clear errors.
 
+mod common;
+
+use common::*;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
-use std::path::Path;
 
 use nalgebra::{DMatrix, DVector};
-use railmbs_models::Model;
+use railmbs_runtime::MechanicalSystem;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
-
-fn parse(text: &str) -> Result<Model, String> {
-    railmbs_models::parse_model(text, Path::new("surface.ron")).map_err(|e| e.to_string())
-}
-
-fn system(model: &Model) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    let params = model.parameter_values(&[], &[]).unwrap();
-    let (q0, v0) = model.initial_state(&params);
-    let sys = ModelSystem::new(model, Box::new(NumericEquations::new(model)), params).unwrap();
-    (sys, q0, v0)
-}
 
 /// A 1 kg bead (translations only) released at rest at x = A in the bowl
 /// z = (x² + y²)/(2R), frictionless, on a stiff contact (503 Hz, ζ = 0.5).
@@ -46,8 +36,8 @@ Model(
 
 #[test]
 fn bead_in_a_bowl_swings_with_the_pendulum_period() {
-    let model = parse(BOWL).unwrap();
-    let (mut sys, q0, v0) = system(&model);
+    let model = parse(BOWL);
+    let (mut sys, q0, v0) = system(&model, &[]);
     let settings = ParkSettings {
         max_step: 1e-3,
         jacobian: JacobianKind::Analytic,
@@ -122,12 +112,9 @@ Model(
 
 #[test]
 fn planar_surface_equals_the_point_plane_contact() {
-    let (surface, plane) = (
-        parse(&sloped(true)).unwrap(),
-        parse(&sloped(false)).unwrap(),
-    );
-    let (mut s1, q, v) = system(&surface);
-    let (mut s2, ..) = system(&plane);
+    let (surface, plane) = (parse(&sloped(true)), parse(&sloped(false)));
+    let (mut s1, q, v) = system(&surface, &[]);
+    let (mut s2, ..) = system(&plane, &[]);
     let n = q.len();
     for (va, stick) in [(0.3, false), (0.0, true)] {
         let mut v = v.clone();
@@ -156,18 +143,18 @@ fn planar_surface_equals_the_point_plane_contact() {
 #[test]
 fn bad_surfaces_are_refused_with_the_element_named() {
     let unknown = BOWL.replace("(x^2 + y^2)/(2*R)", "z^2");
-    let e = parse(&unknown).unwrap_err();
+    let e = try_parse(&unknown).unwrap_err();
     assert!(
         e.contains("bowl") && e.contains("surface") && e.contains("\"z\""),
         "{e}"
     );
     let with_normal = BOWL.replace("surface:", "normal: (0, 1, 1), surface:");
-    let e = parse(&with_normal).unwrap_err();
+    let e = try_parse(&with_normal).unwrap_err();
     assert!(e.contains("normal"), "{e}");
     // A surface undefined under the point stops the evaluation with the place.
     let domain = BOWL.replace("(x^2 + y^2)/(2*R)", "sqrt(1e-4 - x^2)");
-    let model = parse(&domain).unwrap();
-    let (mut sys, mut q, v) = system(&model);
+    let model = parse(&domain);
+    let (mut sys, mut q, v) = system(&model, &[]);
     q[0] = 0.02;
     let n = q.len();
     let e = sys
@@ -184,8 +171,8 @@ fn bad_surfaces_are_refused_with_the_element_named() {
     // A kink (the slope of abs is 0/0 at 0) is not an error: the point on
     // the ridge of the V-shaped surface z = 0.1|x| is pushed straight up.
     let kink = BOWL.replace("(x^2 + y^2)/(2*R)", "0.1*abs(x)");
-    let model = parse(&kink).unwrap();
-    let (mut sys, mut q, v) = system(&model);
+    let model = parse(&kink);
+    let (mut sys, mut q, v) = system(&model, &[]);
     q[0] = 0.0;
     q[2] = -1e-4;
     let mut f = DVector::zeros(n);

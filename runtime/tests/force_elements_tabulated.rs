@@ -4,10 +4,10 @@
 //! reproduced exactly inside the table (the three-point slope is exact for
 //! them), and the element's Jacobian against central differences.
 
-use std::path::Path;
+mod common;
 
-use nalgebra::{DMatrix, DVector};
-use railmbs_runtime::{MechanicalSystem, ModelSystem, NumericEquations};
+use common::*;
+use railmbs_runtime::ModelSystem;
 
 /// One translating body on a tabulated element along x (x0 = 0.5: the
 /// deflection is the coordinate).
@@ -31,16 +31,9 @@ Model(
     )
 }
 
-fn system(text: &str) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    let m =
-        railmbs_models::parse_model(text, Path::new("tab.ron")).unwrap_or_else(|e| panic!("{e}"));
-    let params = m.parameter_values(&[], &[]).unwrap();
-    let (q, v) = m.initial_state(&params);
-    (
-        ModelSystem::new(&m, Box::new(NumericEquations::new(&m)), params).unwrap(),
-        q,
-        v,
-    )
+/// The system of a model text (see [`model`]) and its initial state.
+fn system_of(text: &str) -> (ModelSystem, Vec<f64>, Vec<f64>) {
+    system(&parse(text), &[])
 }
 
 /// The element's characteristic f(u) (N) at deflection u, read from its
@@ -63,7 +56,7 @@ fn spline_reproduces_a_quadratic_inside_the_table() {
             format!("({u}, {})", 1e4 * u * u)
         })
         .collect();
-    let (mut sys, ..) = system(&model(&format!("[{}]", rows.join(", ")), "Spline"));
+    let (mut sys, ..) = system_of(&model(&format!("[{}]", rows.join(", ")), "Spline"));
     for k in 0..=40 {
         let u = 0.01 + 0.03 * k as f64 / 40.0;
         let f = characteristic(&mut sys, u);
@@ -93,7 +86,7 @@ fn spline_bump_stop_passes_the_rows_without_overshoot() {
     // Clearance ±10 mm, then a progressive stop.
     let table = STOP_TABLE;
     let rows = STOP_ROWS;
-    let (mut sys, ..) = system(&model(table, "Spline"));
+    let (mut sys, ..) = system_of(&model(table, "Spline"));
     for (u, f) in rows {
         assert!((characteristic(&mut sys, u) - f).abs() < 1e-9, "row {u}");
     }
@@ -121,36 +114,22 @@ fn spline_bump_stop_passes_the_rows_without_overshoot() {
         "{}",
         slope_jump(&mut sys)
     );
-    let (mut linear, ..) = system(&model(table, "Linear"));
+    let (mut linear, ..) = system_of(&model(table, "Linear"));
     assert!(slope_jump(&mut linear) > 1e6);
 }
 
 #[test]
 fn spline_element_jacobian_equals_central_differences() {
-    let (mut sys, mut q, v) = system(&model(STOP_TABLE, "Spline"));
+    let (mut sys, mut q, v) = system_of(&model(STOP_TABLE, "Spline"));
     q[0] = 0.5 + 0.0237; // inside a cubic segment
-    let n = q.len();
-    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
-    sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap();
-    let mut mass = DMatrix::zeros(n, n);
-    let (mut fp, mut fm) = (DVector::zeros(n), DVector::zeros(n));
-    for j in 0..n {
-        let h = 1e-7;
-        let (mut qp, mut qm) = (q.clone(), q.clone());
-        qp[j] += h;
-        qm[j] -= h;
-        sys.dynamics(0.0, &qp, &v, &mut mass, &mut fp).unwrap();
-        sys.dynamics(0.0, &qm, &v, &mut mass, &mut fm).unwrap();
-        let col = (&fp - &fm) / (2.0 * h);
-        // Forces ~3e4 N, h = 1e-7 m: rounding ε·3e4/h ≈ 7e-5 N/m, truncation
-        // f'''h²/6 ≈ negligible: 1e-7 of the largest entry (~4e6 N/m).
-        assert!(
-            (col - dq.column(j)).amax() < 1e-7 * dq.amax(),
-            "column {j}: {} vs {}",
-            (&fp - &fm) / (2.0 * h),
-            dq.column(j)
-        );
-    }
+    let (dq, _) = analytic(&mut sys, &q, &v);
+    let fq = central_difference(&mut sys, &q, &v, false, 1e-7);
+    // Forces ~3e4 N, h = 1e-7 m: rounding ε·3e4/h ≈ 7e-5 N/m, truncation
+    // f'''h²/6 ≈ negligible: 1e-7 of the largest entry (~4e6 N/m).
+    assert!(
+        (&fq - &dq).amax() < 1e-7 * dq.amax(),
+        "∂f/∂q\n{dq}\nvs central differences\n{fq}"
+    );
 }
 
 /// The characteristic's energy ∫₀ᵘ f is exact: for a straight-line table the
