@@ -27,16 +27,21 @@ fn run(
     engine: impl Fn(&Model) -> Box<dyn Equations>,
     out: &Path,
 ) -> (Table, railmbs_runtime::simulate::RunSummary) {
-    let models: Vec<Model> = train
-        .vehicles
-        .iter()
-        .map(|v| load_model(&v.model).unwrap())
-        .collect();
+    let models = vehicle_models(train);
     let refs: Vec<&Model> = models.iter().collect();
     let engines = models.iter().map(&engine).collect();
     let summary = run_train(train, &refs, engines, Some(out), |_| {}).unwrap();
     assert!(summary.error.is_none(), "{:?}", summary.error);
     (Table::read(out), summary)
+}
+
+/// The models of a train's vehicles, in vehicle order.
+fn vehicle_models(train: &TrainScenario) -> Vec<Model> {
+    train
+        .vehicles
+        .iter()
+        .map(|v| load_model(&v.model).unwrap())
+        .collect()
 }
 
 fn numeric(model: &Model) -> Box<dyn Equations> {
@@ -319,11 +324,7 @@ fn a_symmetric_train_on_straight_track_stays_centred() {
     let dir = tempfile::tempdir().unwrap();
     let train = train3(3.0);
     let (t, summary) = run(&train, numeric, &dir.path().join("out.csv"));
-    let models: Vec<Model> = train
-        .vehicles
-        .iter()
-        .map(|v| load_model(&v.model).unwrap())
-        .collect();
+    let models = vehicle_models(&train);
     assert_eq!(
         models.iter().map(|m| m.coordinates.len()).sum::<usize>(),
         126
@@ -362,11 +363,7 @@ fn a_symmetric_train_on_straight_track_stays_centred() {
 #[test]
 fn the_coupler_jacobian_matches_finite_differences() {
     let train = train3(1.0);
-    let models: Vec<Model> = train
-        .vehicles
-        .iter()
-        .map(|v| load_model(&v.model).unwrap())
-        .collect();
+    let models = vehicle_models(&train);
     let refs: Vec<&Model> = models.iter().collect();
     let engines = models.iter().map(numeric).collect();
     let mut setup = railmbs_runtime::train::build_train(&train, &refs, engines).unwrap();

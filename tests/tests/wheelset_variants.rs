@@ -409,17 +409,10 @@ fn normal_damping_with_elastic_rails_is_refused() {
 /// stiffness alone 2249 steps, 392 rejected, 41 Jacobians).
 #[test]
 fn newton_converges_on_the_analytic_jacobian_with_elastic_rails() {
-    let mut scenario =
-        railmbs_models::load_scenario(&model_path("scenarios/wheelset_elastic_rail_30.ron"))
-            .unwrap();
-    if let IntegratorSpec::Park { jacobian, .. } = &mut scenario.integrator {
-        *jacobian = railmbs_models::JacobianKind::Analytic;
-    }
-    let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let engine = Box::new(NumericEquations::new(&model));
-    let s =
-        railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
-    assert!(s.error.is_none(), "{:?}", s.error);
+    let s = run_with_jacobian(
+        "scenarios/wheelset_elastic_rail_30.ron",
+        railmbs_models::JacobianKind::Analytic,
+    );
     let per_step = s.newton_iterations as f64 / (s.steps + s.rejected_steps) as f64;
     println!(
         "{} steps ({} rejected), {per_step:.2} Newton iterations per step, {} Jacobians",
@@ -442,17 +435,10 @@ fn newton_converges_on_the_analytic_jacobian_with_elastic_rails() {
 /// Measured: 2318 steps, 59 rejected, 3 Jacobians.
 #[test]
 fn the_finite_difference_jacobian_sees_each_wheels_spin() {
-    let mut scenario =
-        railmbs_models::load_scenario(&model_path("scenarios/wheelset_irw_off_centre.ron"))
-            .unwrap();
-    if let IntegratorSpec::Park { jacobian, .. } = &mut scenario.integrator {
-        *jacobian = railmbs_models::JacobianKind::FiniteDifference;
-    }
-    let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let engine = Box::new(NumericEquations::new(&model));
-    let s =
-        railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
-    assert!(s.error.is_none(), "{:?}", s.error);
+    let s = run_with_jacobian(
+        "scenarios/wheelset_irw_off_centre.ron",
+        railmbs_models::JacobianKind::FiniteDifference,
+    );
     println!(
         "{} steps ({} rejected), {} Jacobians",
         s.steps, s.rejected_steps, s.jacobian_evaluations
@@ -692,4 +678,22 @@ fn elastic_rails_balance_a_lateral_axle_force_on_the_flange_root() {
         (total - force).abs() < 0.01 * force,
         "k_y Σd_y {total} N, F {force} N"
     );
+}
+
+/// Runs a bundled scenario (no output file) with Park's Jacobian of `kind`;
+/// returns the run's summary.
+fn run_with_jacobian(
+    scenario: &str,
+    kind: railmbs_models::JacobianKind,
+) -> railmbs_runtime::simulate::RunSummary {
+    let mut scenario = railmbs_models::load_scenario(&model_path(scenario)).unwrap();
+    if let IntegratorSpec::Park { jacobian, .. } = &mut scenario.integrator {
+        *jacobian = kind;
+    }
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let engine = Box::new(NumericEquations::new(&model));
+    let s =
+        railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
+    assert!(s.error.is_none(), "{:?}", s.error);
+    s
 }
