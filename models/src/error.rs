@@ -17,6 +17,13 @@ pub struct ModelError {
     pub position: Option<(usize, usize)>,
 }
 
+/// The text of `path`, or an error saying which `kind` of file (model,
+/// scenario, train) could not be read and why.
+pub(crate) fn read_text(path: &Path, kind: &str) -> Result<String, ModelError> {
+    std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(path, "", format!("cannot read the {kind} file: {e}")))
+}
+
 impl ModelError {
     /// An error without a position.
     pub fn new(file: &Path, element: impl Into<String>, message: impl Into<String>) -> Self {

@@ -15,8 +15,7 @@ use include::{Connection, Includes, Loaded, Node, Sub, close_matches, force_valu
 /// Reads and resolves a model file, flattening its subsystems (recursively).
 /// All problems found are returned together.
 pub fn load_model(path: &Path) -> Result<Model, ModelErrors> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError::new(path, "", format!("cannot read the model file: {e}")))?;
+    let text = crate::error::read_text(path, "model")?;
     parse_model(&text, path)
 }
 

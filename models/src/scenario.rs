@@ -215,8 +215,7 @@ struct RawOutput {
 /// coordinates are checked against the model by [`Scenario::parameter_values`]
 /// and [`Scenario::initial_state`].
 pub fn load_scenario(path: &Path) -> Result<Scenario, ModelErrors> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError::new(path, "", format!("cannot read the scenario file: {e}")))?;
+    let text = crate::error::read_text(path, "scenario")?;
     parse_scenario(&text, path)
 }
 
@@ -724,8 +723,7 @@ fn top_constructor(text: &str) -> Option<&str> {
 /// Reads a scenario file of either kind: `Train(...)` files are trains,
 /// anything else goes to [`load_scenario`].
 pub fn load_any_scenario(path: &Path) -> Result<AnyScenario, ModelErrors> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError::new(path, "", format!("cannot read the scenario file: {e}")))?;
+    let text = crate::error::read_text(path, "scenario")?;
     if top_constructor(&text) == Some("Train") {
         parse_train(&text, path).map(AnyScenario::Train)
     } else {
@@ -735,8 +733,7 @@ pub fn load_any_scenario(path: &Path) -> Result<AnyScenario, ModelErrors> {
 
 /// Reads a train file (`Train(...)`).
 pub fn load_train(path: &Path) -> Result<TrainScenario, ModelErrors> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError::new(path, "", format!("cannot read the train file: {e}")))?;
+    let text = crate::error::read_text(path, "train")?;
     parse_train(&text, path)
 }
 
