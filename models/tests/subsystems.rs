@@ -605,6 +605,22 @@ const VEHICLE: &str = r#"Model(
 )
 "#;
 
+/// Loads `vehicle` over the standard bogie and wheelset files: its one error
+/// containing `needle` must be located at `at` and name `element`.
+fn vehicle_error(vehicle: &str, at: &str, element: &str, needle: &str) -> ModelError {
+    let files = tree(vehicle, BOGIE, WHEELSET);
+    let errors = files.errors("vehicle.ron");
+    located(
+        &errors,
+        &files.path("vehicle.ron"),
+        vehicle,
+        at,
+        element,
+        needle,
+    )
+    .clone()
+}
+
 fn tree(vehicle: &str, bogie: &str, ws: &str) -> Files {
     let ws = ws.replace(
         "    forces: [\n        WheelRail(name: \"Contact\", wheelset: \"axle\", wheel_profile: \"../profiles/wheel.prw\",\n                  rail_profile: \"../profiles/rail.ban\", radius: \"r0\"),\n    ],\n",
@@ -740,11 +756,7 @@ fn unknown_override_names_subsystem_file_and_parameter() {
 fn bad_override_values_are_located_at_the_override() {
     // Unknown identifier in the includer's namespace.
     let vehicle = VEHICLE.replacen("\"offset\": \"lb\"", "\"offset\": \"lb + a\"", 1);
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "\"lb + a\"",
         "subsystem \"Bogie1\"",
@@ -752,11 +764,7 @@ fn bad_override_values_are_located_at_the_override() {
     );
     // A cycle through an override.
     let vehicle = VEHICLE.replacen("\"lb\": 9.5", "\"lb\": \"Bogie1.offset\"", 1);
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "\"lb\": \"Bogie1",
         "parameter \"lb\"",
@@ -828,11 +836,7 @@ fn unknown_long_names_list_close_matches() {
         "joint: Rigid(parent: \"Bogie1.WS1.BoxLeft\")",
         1,
     );
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "\"Bogie1.WS1.BoxLeft\"",
         "body \"carbody\"",
@@ -869,11 +873,7 @@ fn reattaching_a_track_body_is_an_error() {
         "parameters: { \"offset\": \"lb\" }, parent: \"carbdy\"",
         1,
     );
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "\"carbdy\"",
         "subsystem \"Bogie1\"",
@@ -922,11 +922,7 @@ fn errors_inside_included_files_name_that_file_and_the_instance() {
 fn names_must_not_clash() {
     // A body of the includer with a subsystem body's long name.
     let vehicle = VEHICLE.replacen("name: \"carbody\"", "name: \"Bogie1.frame\"", 1);
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "name: \"Bogie1.frame\"",
         "body \"Bogie1.frame\"",
@@ -958,11 +954,7 @@ fn names_must_not_clash() {
         "    connections: { \"carbody\": (body: \"carbody\") },\n    forces: [",
         1,
     );
-    let files = tree(&vehicle, BOGIE, WHEELSET);
-    let errors = files.errors("vehicle.ron");
-    located(
-        &errors,
-        &files.path("vehicle.ron"),
+    vehicle_error(
         &vehicle,
         "\"carbody\": (",
         "connection \"carbody\"",
