@@ -3,46 +3,13 @@
 //! (E.A.H. Vollebregt, CONTACT, `../shared/reference/contact`), and the
 //! saturation limit μN (Coulomb).
 
+mod common;
+
+use common::*;
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, FastsimLayout,
     KalkerLinear, Mueller, Polach, SlidingZone, TractionBound,
 };
-
-const REF: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/reference/contact/"
-);
-
-/// Rows of a CONTACT result CSV as (header → value) lookups.
-fn contact_rows(file: &str) -> Vec<std::collections::HashMap<String, String>> {
-    let mut rd = csv::Reader::from_path(format!("{REF}{file}")).expect("reference CSV");
-    let hdr = rd.headers().unwrap().clone();
-    rd.records()
-        .map(|r| {
-            let r = r.unwrap();
-            hdr.iter()
-                .map(str::to_string)
-                .zip(r.iter().map(str::to_string))
-                .collect()
-        })
-        .collect()
-}
-
-fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
-    row[key].parse().unwrap()
-}
-
-fn tread_patch() -> ContactPatch {
-    // A typical tread contact: a = 6 mm, b = 4 mm, steel G = 80 GPa, ν = 0.28.
-    ContactPatch {
-        a: 6e-3,
-        b: 4e-3,
-        g: 80e9,
-        nu: 0.28,
-        mu: 0.3,
-        n: 80e3,
-    }
-}
 
 /// At small creepage FASTSIM and FastSim_A reproduce Kalker's linear theory: the
 /// flexibilities L1, L2, L3 are defined so that the continuous simplified theory
@@ -149,25 +116,6 @@ fn large_creepage_saturates_at_mu_n() {
     }
 }
 
-fn contact_patch_mm(row: &std::collections::HashMap<String, String>) -> (ContactPatch, Creepages) {
-    // CONTACT units: mm, N, N/mm², spin rad/mm → SI.
-    (
-        ContactPatch {
-            a: num(row, "AA") * 1e-3,
-            b: num(row, "BB") * 1e-3,
-            g: num(row, "G") * 1e6,
-            nu: num(row, "NU"),
-            mu: num(row, "FSTAT"),
-            n: num(row, "FN"),
-        },
-        Creepages {
-            xi: num(row, "CKSI"),
-            eta: num(row, "CETA"),
-            phi: num(row, "CPHI") * 1e3,
-        },
-    )
-}
-
 /// CONTACT's FASTSIM example (a = 8, b = 4 mm, η = −0.000625, φ = 0.000625/mm):
 /// our FASTSIM on CONTACT's grid (MX = MY = 44 and 220 over 1.1× the ellipse)
 /// against CONTACT's FASTSIM with the parabolic and the elliptic bound.
@@ -185,8 +133,8 @@ fn contact_fastsim_example() {
     let rows = contact_rows("contact_fastsim_example.csv");
     let mut checked = 0;
     for row in &rows {
-        let (m, b, mx) = (num(row, "M"), num(row, "B"), num(row, "MX"));
-        if m != 3.0 || num(row, "CHI") != 0.0 {
+        let (m, b, mx) = (row["M"], row["B"], row["MX"]);
+        if m != 3.0 || row["CHI"] != 0.0 {
             continue;
         }
         let bound = if b == 3.0 {
@@ -194,7 +142,7 @@ fn contact_fastsim_example() {
         } else {
             TractionBound::Elliptic
         };
-        let (p, c) = contact_patch_mm(row);
+        let (p, c) = contact_case(row);
         let law = Fastsim::new(mx as usize, mx as usize)
             .unwrap()
             .with_bound(bound)
@@ -202,8 +150,8 @@ fn contact_fastsim_example() {
             .unwrap();
         let f = law.forces(&p, &c).unwrap();
         let fy = f.fy / (p.mu * p.n);
-        let fy_ref = num(row, "FY_over_muFN");
-        let mz_ref = num(row, "MZ") * 1e-3; // N·mm → N·m
+        let fy_ref = row["FY_over_muFN"];
+        let mz_ref = row["MZ"] * 1e-3; // N·mm → N·m
         let tol = if mx > 100.0 { 0.01 } else { 0.03 };
         assert!(
             (fy / fy_ref - 1.0).abs() < tol,
@@ -218,8 +166,8 @@ fn contact_fastsim_example() {
     }
     assert_eq!(checked, 4);
     // Exact theory, case 1.
-    let (p, c) = contact_patch_mm(&rows[0]);
-    let exact = num(&rows[0], "FY_over_muFN");
+    let (p, c) = contact_case(&rows[0]);
+    let exact = rows[0]["FY_over_muFN"];
     assert_eq!(exact, -0.6074);
     let f = Fastsim::new(100, 100).unwrap().forces(&p, &c).unwrap();
     let fy = f.fy / (p.mu * p.n);
@@ -253,8 +201,8 @@ fn contact_traction_curves() {
     let mut worst_exact = 0.0_f64;
     for (i, row) in rows.iter().enumerate() {
         let case = i + 1;
-        let (p, c) = contact_patch_mm(row);
-        let fx_ref = num(row, "FX_over_muFN");
+        let (p, c) = contact_case(row);
+        let fx_ref = row["FX_over_muFN"];
         let mu_n = p.mu * p.n;
         if (61..=90).contains(&case) {
             let f = grid.forces(&p, &c).unwrap();

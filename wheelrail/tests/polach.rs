@@ -6,57 +6,12 @@
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, KalkerLinear, Polach,
 };
-use std::collections::HashMap;
+mod common;
 
-const REF: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/reference/contact/"
-);
-
-fn tread_patch() -> ContactPatch {
-    // A typical tread contact: a = 6 mm, b = 4 mm, steel G = 80 GPa, ν = 0.28.
-    ContactPatch {
-        a: 6e-3,
-        b: 4e-3,
-        g: 80e9,
-        nu: 0.28,
-        mu: 0.3,
-        n: 80e3,
-    }
-}
+use common::*;
 
 fn cr(xi: f64, eta: f64, phi: f64) -> Creepages {
     Creepages { xi, eta, phi }
-}
-
-/// Rows of a CONTACT result CSV as (header → value) lookups.
-fn contact_rows(file: &str) -> Vec<HashMap<String, f64>> {
-    let mut rd = csv::Reader::from_path(format!("{REF}{file}")).expect("reference CSV");
-    let hdr = rd.headers().unwrap().clone();
-    rd.records()
-        .map(|r| {
-            let r = r.unwrap();
-            hdr.iter()
-                .zip(r.iter())
-                .filter_map(|(h, v)| Some((h.to_string(), v.parse().ok()?)))
-                .collect()
-        })
-        .collect()
-}
-
-/// CONTACT units (mm, N, N/mm², rad/mm) → SI.
-fn contact_case(row: &HashMap<String, f64>) -> (ContactPatch, Creepages) {
-    (
-        ContactPatch {
-            a: row["AA"] * 1e-3,
-            b: row["BB"] * 1e-3,
-            g: row["G"] * 1e6,
-            nu: row["NU"],
-            mu: row["FSTAT"],
-            n: row["FN"],
-        },
-        cr(row["CKSI"], row["CETA"], row["CPHI"] * 1e3),
-    )
 }
 
 fn rel(x: f64, r: f64) -> f64 {
