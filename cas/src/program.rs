@@ -236,7 +236,7 @@ impl Builder {
         match node {
             Node::Num(v) => Operand::Const(*v),
             Node::Sym(s) => Operand::Sym(*s),
-            Node::Add { constant, terms } => self.lower_sum(*constant, terms, op),
+            Node::Add { constant, terms } => self.lower_sum(*constant, terms, &[], op),
             Node::Mul { factors } => {
                 let mut num: Option<Operand> = None;
                 let mut den: Option<Operand> = None;
@@ -264,15 +264,18 @@ impl Builder {
     /// `c·a + c·b − c·d = c·(a + b − d)`. Negation is folded into subtractions: positive items
     /// are added first, then the constant, then negative items subtracted. With no positive
     /// part, an item with |c| ≠ 1 takes the sign into its multiplication; only a sum of
-    /// unit-negative terms needs an explicit negation.
+    /// unit-negative terms needs an explicit negation. `pre` are already lowered partial sums
+    /// (negated when the flag is set) added before the terms.
     fn lower_sum(
         &mut self,
         constant: f64,
         terms: &[(ExprId, f64)],
+        pre: &[(Operand, bool)],
         op: impl Fn(ExprId) -> Operand,
     ) -> Operand {
         // Items: (operand, |coefficient|, negative?), groups in order of first appearance.
-        let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len());
+        let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len() + pre.len());
+        items.extend(pre.iter().map(|&(o, neg)| (o, 1.0, neg)));
         let mut groups: Vec<(f64, Vec<Operand>, Vec<Operand>)> = Vec::new();
         let mut group_of: FxMap<u64, usize> = FxMap::default();
         for &(b, c) in terms {
@@ -387,18 +390,33 @@ pub struct Program {
 
 impl Program {
     /// Common-subexpression elimination of `outputs` (all together) into a program.
+    ///
+    /// Besides equal nodes (hash-consing) and equal instructions, sums share their common
+    /// parts: a sum that contains all terms of another sum of the program (with the same or
+    /// all opposite coefficients) is lowered as that sum plus the rest. Recursive formulas that
+    /// simplification flattened, such as the mass matrix's M_ij = M_(i+1)j + …, get their
+    /// recursion back this way.
     pub fn compile(ctx: &Context, outputs: &[ExprId]) -> Program {
         let order = ctx.reachable(outputs);
         // about 1.5 instructions per node in practice (binary chains of n-ary nodes)
-        let mut b = Builder::new(true, order.len() + order.len() / 2);
+        let b = Builder::new(true, order.len() + order.len() / 2);
         let size = order.last().map_or(0, |l| l.index() + 1);
-        let mut ops: Vec<Operand> = vec![Operand::Const(0.0); size];
-        for id in order {
-            ops[id.index()] = b.lower(ctx.node(id), |c| ops[c.index()]);
+        let mut lowering = Lowering {
+            ctx,
+            b,
+            ops: vec![None; size],
+            sums: SumIndex::new(ctx, &order),
+        };
+        for &id in &order {
+            lowering.lower(id);
         }
+        let ops = lowering.ops;
         Program {
-            instrs: b.instrs,
-            outputs: outputs.iter().map(|o| ops[o.index()]).collect(),
+            instrs: lowering.b.instrs,
+            outputs: outputs
+                .iter()
+                .map(|o| ops[o.index()].expect("every output lowered"))
+                .collect(),
         }
     }
 
@@ -575,6 +593,142 @@ impl Program {
 }
 
 /// Outputs that are inputs or constants bypass the instruction checks: check them here.
+/// A sum split into partial sums (each with `true` when it enters negated), the terms left
+/// over and the constant left over.
+type SumParts = (Vec<(ExprId, bool)>, Vec<(ExprId, f64)>, f64);
+
+/// The sums (of at least two terms) among the nodes being compiled, indexed by term.
+struct SumIndex {
+    /// Per sum: node, constant, number of terms.
+    sums: Vec<(ExprId, f64, usize)>,
+    /// Sum number of each sum node.
+    of_node: FxMap<ExprId, u32>,
+    /// For each term base: the sums containing it, with its coefficient there.
+    by_term: FxMap<ExprId, Vec<(u32, f64)>>,
+}
+
+impl SumIndex {
+    /// At most this many partial sums are taken into one sum.
+    const MAX_PARTS: usize = 4;
+
+    fn new(ctx: &Context, order: &[ExprId]) -> Self {
+        let mut index = SumIndex {
+            sums: Vec::new(),
+            of_node: FxMap::default(),
+            by_term: FxMap::default(),
+        };
+        for &id in order {
+            if let Node::Add { constant, terms } = ctx.node(id)
+                && terms.len() >= 2
+            {
+                let k = index.sums.len() as u32;
+                index.sums.push((id, *constant, terms.len()));
+                index.of_node.insert(id, k);
+                for &(base, c) in terms.iter() {
+                    index.by_term.entry(base).or_default().push((k, c));
+                }
+            }
+        }
+        index
+    }
+
+    /// Other sums whose terms are all among `terms` (disjoint from each other), largest first,
+    /// each with `true` when it enters negated; and the terms and constant left over.
+    fn parts(&self, id: ExprId, constant: f64, terms: &[(ExprId, f64)]) -> SumParts {
+        let mut rest: Vec<(ExprId, f64)> = terms.to_vec();
+        let mut rest_constant = constant;
+        let mut parts = Vec::new();
+        let Some(&me) = self.of_node.get(&id) else {
+            return (parts, rest, rest_constant);
+        };
+        while parts.len() < Self::MAX_PARTS && rest.len() >= 2 {
+            // Per candidate sum: how many of its terms are here with equal / opposite coefficient.
+            let mut hits: FxMap<u32, (usize, usize)> = FxMap::default();
+            for &(base, c) in &rest {
+                for &(k, ck) in self.by_term.get(&base).map_or(&[][..], |v| v) {
+                    if k == me {
+                        continue;
+                    }
+                    let h = hits.entry(k).or_default();
+                    if ck == c {
+                        h.0 += 1;
+                    } else if ck == -c {
+                        h.1 += 1;
+                    }
+                }
+            }
+            let best = hits
+                .iter()
+                .filter_map(|(&k, &(same, opposite))| {
+                    let (node, kc, len) = self.sums[k as usize];
+                    let negated = if same == len {
+                        false
+                    } else if opposite == len {
+                        true
+                    } else {
+                        return None;
+                    };
+                    let kc = if negated { -kc } else { kc };
+                    // The same terms again only as the constant-free sum, so that two sums
+                    // never refer to each other (T = −S).
+                    let smaller = len < terms.len() || (!negated && kc == 0.0 && constant != 0.0);
+                    (smaller && (kc == 0.0 || kc == rest_constant))
+                        .then_some((len, node, negated, kc))
+                })
+                .max_by_key(|&(len, node, ..)| (len, std::cmp::Reverse(node)));
+            let Some((_, node, negated, kc)) = best else {
+                break;
+            };
+            let k = self.of_node[&node];
+            rest.retain(|(base, _)| !self.by_term[base].iter().any(|&(s, _)| s == k));
+            rest_constant -= kc;
+            parts.push((node, negated));
+        }
+        (parts, rest, rest_constant)
+    }
+}
+
+/// Lowering of the reachable nodes in dependency order, a sum's partial sums first.
+struct Lowering<'a> {
+    ctx: &'a Context,
+    b: Builder,
+    ops: Vec<Option<Operand>>,
+    sums: SumIndex,
+}
+
+impl Lowering<'_> {
+    /// Lowers `id` unless done; its operands must be lowered already.
+    fn lower(&mut self, id: ExprId) -> Operand {
+        if let Some(o) = self.ops[id.index()] {
+            return o;
+        }
+        let node = self.ctx.node(id);
+        let result = match node {
+            Node::Add { constant, terms } if terms.len() >= 2 => {
+                let (parts, rest, rest_constant) = self.sums.parts(id, *constant, terms);
+                // A partial sum's terms are terms of this sum, so they are lowered; its
+                // own partial sums have fewer terms still (the recursion ends).
+                let pre: Vec<(Operand, bool)> = parts
+                    .iter()
+                    .map(|&(p, negated)| (self.lower(p), negated))
+                    .collect();
+                let ops = &self.ops;
+                self.b.lower_sum(rest_constant, &rest, &pre, |c| {
+                    ops[c.index()].expect("operand lowered before its user")
+                })
+            }
+            _ => {
+                let ops = &self.ops;
+                self.b.lower(node, |c| {
+                    ops[c.index()].expect("operand lowered before its user")
+                })
+            }
+        };
+        self.ops[id.index()] = Some(result);
+        result
+    }
+}
+
 fn check_output(i: usize, x: f64) -> Result<f64, CasError> {
     if x.is_finite() {
         Ok(x)

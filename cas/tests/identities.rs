@@ -712,3 +712,34 @@ fn split_program_matches_and_reuses_slots() {
         assert!(sp.n_slots <= prog.instrs.len());
     }
 }
+
+#[test]
+fn sums_reuse_the_sums_they_contain() {
+    // M_0 = x0 + … + x5, M_1 = x1 + … + x5, …: the recursion M_i = M_(i+1) + x_i that
+    // flattening hid comes back as one addition per sum, in whatever order the sums are asked
+    // for (the largest first here). A sum containing another's terms negated subtracts it,
+    // and a sum that is another plus a constant adds the constant.
+    let mut c = Context::new();
+    let x: Vec<ExprId> = (0..6).map(|i| c.q(i)).collect();
+    let sums: Vec<ExprId> = (0..5).map(|i| c.add_many(&x[i..])).collect();
+    let tail = c.add_many(&x[3..]);
+    let minus_tail = c.neg(tail);
+    let y = c.p(0);
+    let opposite = c.add(minus_tail, y); // y − (x3 + x4 + x5)
+    let two = c.num(2.0);
+    let shifted = c.add(sums[0], two); // 2 + x0 + … + x5
+    let mut outputs = sums.clone();
+    outputs.extend([opposite, shifted]);
+    let prog = Program::compile(&c, &outputs);
+    let adds = prog.op_counts().adds;
+    // x4 + x5, then one addition each for the four larger sums, one subtraction for
+    // `opposite` and one addition for `shifted`.
+    assert_eq!(adds, 1 + 4 + 1 + 1, "{prog}");
+    let q: Vec<f64> = (0..6).map(|i| 1.0 + 0.5 * i as f64).collect();
+    let vals = Values {
+        q: &q,
+        p: &[0.25],
+        ..Default::default()
+    };
+    assert_eq!(prog.eval(&vals).unwrap(), c.eval(&outputs, &vals).unwrap());
+}
