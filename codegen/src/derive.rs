@@ -262,6 +262,11 @@ struct State {
     w: V3,
     acc0: V3,
     alpha0: V3,
+    /// Gravity, m/s², in the basis the other vectors are expressed in.
+    g: V3,
+    /// In the tree-local pass: no generalized coordinate on the path yet
+    /// (the vectors are expressed in the current frame; see [`forward`]).
+    pre: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -278,41 +283,69 @@ struct AxisInfo {
     p: V3,
 }
 
-/// Derives all equations of `model`.
-pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
-    let mut ctx = Context::new();
+/// The result of one forward pass over the bodies.
+struct Forward {
+    states: Vec<State>,
+    axes: Vec<Option<AxisInfo>>,
+    chains: Vec<Vec<usize>>,
+    children: Vec<Vec<usize>>,
+    masses: Vec<ExprId>,
+    /// Inertia about the centre of mass in the pass's basis.
+    inertia_g: Vec<M3>,
+    /// The path of elementary transformations as a tree of op nodes:
+    /// translation vector and parent node of each.
+    ops: Vec<OpNode>,
+    /// Each body's last op node.
+    body_end: Vec<Option<usize>>,
+    /// Op node of each coordinate.
+    op_of: Vec<usize>,
+}
+
+/// The forward pass (see runtime::numeric for the formulas).
+///
+/// `local == false`: everything in SC0 (body kinematics, Jacobians,
+/// constraints). `local == true`: the pass for M, k and Q_g, which are scalar
+/// projections and so do not depend on the basis or the reference point the
+/// vectors are taken in. On each path from SC0, the transformations before the
+/// first generalized coordinate (a vehicle body's track-following frame: six
+/// runtime inputs) are walked with every vector expressed in the current frame,
+/// and from the first coordinate on the vectors stay in that frame's basis with
+/// its origin as the reference point. The frame's own motion then enters only
+/// through its velocity, angular velocity, accelerations and gravity in its own
+/// basis (a few expressions per tree) instead of through its rotation matrix in
+/// every entry of M and k.
+fn forward(
+    alg: &mut Alg,
+    model: &Model,
+    opts: &DeriveOptions,
+    gravity: V3,
+    local: bool,
+) -> Forward {
     let n = model.coordinates.len();
     let nb = model.bodies.len();
-    let mut states: Vec<State> = Vec::with_capacity(nb);
-    let mut axes: Vec<Option<AxisInfo>> = vec![None; n];
-    let mut chains: Vec<Vec<usize>> = Vec::with_capacity(nb);
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); nb];
-    let mut masses = Vec::with_capacity(nb);
-    let mut inertia_g: Vec<M3> = Vec::with_capacity(nb);
-    // The path of elementary transformations as a tree of op nodes: translation
-    // vector (SC0) and coordinate of each, parent node, and each body's last node.
-    // Relative vectors between points of the mechanism are sums of the
-    // translations between them (short sums, never differences of long ones).
-    let mut ops: Vec<OpNode> = Vec::new();
-    let mut body_end: Vec<Option<usize>> = Vec::with_capacity(nb);
-    let mut op_of: Vec<usize> = vec![0; n];
-
-    let mut alg = Alg::new(&mut ctx);
-    let gravity: V3 = [0, 1, 2].map(|k| expr_to_cas(alg.ctx, &model.gravity[k], opts));
-
-    // Forward pass (see runtime::numeric for the formulas).
+    let mut f = Forward {
+        states: Vec::with_capacity(nb),
+        axes: vec![None; n],
+        chains: Vec::with_capacity(nb),
+        children: vec![Vec::new(); nb],
+        masses: Vec::with_capacity(nb),
+        inertia_g: Vec::with_capacity(nb),
+        ops: Vec::new(),
+        body_end: Vec::with_capacity(nb),
+        op_of: vec![0; n],
+    };
     for (j, body) in model.bodies.iter().enumerate() {
         let parent = match body.parent {
             BodyRef::Ground => None,
             BodyRef::Body(p) => Some(p),
         };
         if let Some(p) = parent {
-            children[p].push(j);
+            f.children[p].push(j);
         }
-        let mut chain = parent.map(|p| chains[p].clone()).unwrap_or_default();
-        let mut last_op = parent.and_then(|p| body_end[p]);
+        let mut chain = parent.map(|p| f.chains[p].clone()).unwrap_or_default();
+        let mut last_op = parent.and_then(|p| f.body_end[p]);
         let mut s = match parent {
-            Some(p) => states[p],
+            Some(p) => f.states[p],
             None => State {
                 r: alg.v_zero(),
                 a: alg.identity(),
@@ -320,6 +353,8 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                 w: alg.v_zero(),
                 acc0: alg.v_zero(),
                 alpha0: alg.v_zero(),
+                g: gravity,
+                pre: local,
             },
         };
         for el in &body.joint {
@@ -354,29 +389,77 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
                     )
                 }
             };
-            let u = alg.column(&s.a, axis);
             let coord = match &el.motion {
                 Motion::Coordinate(i) => Some(*i),
                 _ => None,
             };
+            if s.pre && coord.is_some() {
+                // From here on the vectors stay in this frame's basis (whose
+                // origin is the reference point: r = 0, A = E).
+                s.pre = false;
+            }
+            if s.pre {
+                // Still before the first coordinate: the absolute velocities and
+                // accelerations of the current frame, in its own basis.
+                let mut e = alg.v_zero();
+                e[axis] = alg.ctx.num(1.0);
+                if rotation {
+                    let w_rel = alg.scale(rate, e);
+                    let c = alg.cross(s.w, w_rel);
+                    let ua = alg.scale(acc, e);
+                    let t = alg.add(c, ua);
+                    let alpha0 = alg.add(s.alpha0, t);
+                    let w = alg.add(s.w, w_rel);
+                    // New basis: x' = Rᵀ x.
+                    let rt = alg.rotation(axis, val);
+                    let rt = [0, 1, 2].map(|r| [0, 1, 2].map(|c| rt[c][r]));
+                    s.w = alg.mat_vec(&rt, w);
+                    s.alpha0 = alg.mat_vec(&rt, alpha0);
+                    s.v = alg.mat_vec(&rt, s.v);
+                    s.acc0 = alg.mat_vec(&rt, s.acc0);
+                    s.g = alg.mat_vec(&rt, s.g);
+                } else {
+                    let d = alg.scale(val, e);
+                    let v_rel = alg.scale(rate, e);
+                    let t1 = alg.cross(s.alpha0, d);
+                    let wd = alg.cross(s.w, d);
+                    let t2 = alg.cross(s.w, wd);
+                    let wv = alg.cross(s.w, v_rel);
+                    let t3 = alg.scale_num(2.0, wv);
+                    let t4 = alg.scale(acc, e);
+                    let sum = alg.add(t1, t2);
+                    let sum = alg.add(sum, t3);
+                    let sum = alg.add(sum, t4);
+                    s.acc0 = alg.add(s.acc0, sum);
+                    let dv = alg.add(wd, v_rel);
+                    s.v = alg.add(s.v, dv);
+                }
+                f.ops.push(OpNode {
+                    parent: last_op,
+                    d: None,
+                });
+                last_op = Some(f.ops.len() - 1);
+                continue;
+            }
+            let u = alg.column(&s.a, axis);
             if let Some(i) = coord {
-                axes[i] = Some(AxisInfo {
+                f.axes[i] = Some(AxisInfo {
                     rotation,
                     u,
                     p: s.r,
                 });
-                op_of[i] = ops.len();
+                f.op_of[i] = f.ops.len();
             }
             let d_op = if rotation {
                 None
             } else {
                 Some(alg.scale(val, u))
             };
-            ops.push(OpNode {
+            f.ops.push(OpNode {
                 parent: last_op,
                 d: d_op,
             });
-            last_op = Some(ops.len() - 1);
+            last_op = Some(f.ops.len() - 1);
             if rotation {
                 let w_rel = alg.scale(rate, u);
                 let c = alg.cross(s.w, w_rel);
@@ -411,12 +494,45 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             [iv[3], iv[1], iv[5]],
             [iv[4], iv[5], iv[2]],
         ];
-        inertia_g.push(alg.rotate_tensor(&s.a, &ib));
-        masses.push(m);
-        states.push(s);
-        chains.push(chain);
-        body_end.push(last_op);
+        f.inertia_g.push(alg.rotate_tensor(&s.a, &ib));
+        f.masses.push(m);
+        f.states.push(s);
+        f.chains.push(chain);
+        f.body_end.push(last_op);
     }
+    f
+}
+
+/// Where body `b`'s own coordinates are in its chain (after its parent's).
+fn own_range(model: &Model, chains: &[Vec<usize>], b: usize) -> std::ops::RangeFrom<usize> {
+    match model.bodies[b].parent {
+        BodyRef::Ground => 0..,
+        BodyRef::Body(p) => chains[p].len()..,
+    }
+}
+
+/// Derives all equations of `model`.
+pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
+    let mut ctx = Context::new();
+    let n = model.coordinates.len();
+    let nb = model.bodies.len();
+    let mut alg = Alg::new(&mut ctx);
+    let gravity: V3 = [0, 1, 2].map(|k| expr_to_cas(alg.ctx, &model.gravity[k], opts));
+    // SC0 pass for the kinematics, Jacobians and constraints; the tree-local
+    // pass for M, k and Q_g.
+    let global = forward(&mut alg, model, opts, gravity, false);
+    let Forward {
+        states,
+        axes,
+        chains,
+        children,
+        masses,
+        inertia_g,
+        ops,
+        body_end,
+        op_of,
+    } = forward(&mut alg, model, opts, gravity, true);
+
     // Σ of the translations on the path from node `from` up to (not including) `stop`.
     let sum_d = |alg: &mut Alg, from: Option<usize>, stop: Option<usize>| -> V3 {
         let mut terms: [Vec<ExprId>; 3] = [Vec::new(), Vec::new(), Vec::new()];
@@ -442,43 +558,25 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         .collect();
     // r_b − p_i for every coordinate i of body b.
     let mut to_com: Vec<V3> = vec![alg.v_zero(); n];
-    let mut coord_body = vec![0usize; n];
     for b in 0..nb {
-        let pe = parent_end(b);
-        let own: Vec<usize> = {
-            let parent_len = match model.bodies[b].parent {
-                BodyRef::Ground => 0,
-                BodyRef::Body(p) => chains[p].len(),
-            };
-            chains[b][parent_len..].to_vec()
-        };
-        for i in own {
-            coord_body[i] = b;
+        for &i in &chains[b][own_range(model, &chains, b)] {
             let stop = ops[op_of[i]].parent;
-            let _ = pe;
             to_com[i] = sum_d(&mut alg, body_end[b], stop);
         }
     }
     // p_i − p_prev(i) for consecutive coordinates on a chain (prev = the
     // coordinate before i on the path from SC0).
     let mut seg_coord: Vec<V3> = vec![alg.v_zero(); n];
-    for (b, chain) in chains.iter().enumerate() {
-        for (pos, &i) in chain.iter().enumerate() {
-            if pos == 0 || coord_body[i] != b {
-                continue;
-            }
-            let prev = chain[pos - 1];
+    for b in 0..nb {
+        let chain = &chains[b];
+        let own = own_range(model, &chains, b);
+        for pos in own.start.max(1)..chain.len() {
+            let (i, prev) = (chain[pos], chain[pos - 1]);
             seg_coord[i] = sum_d(&mut alg, ops[op_of[i]].parent, ops[op_of[prev]].parent);
         }
     }
 
-    let own_coordinates = |b: usize| -> &[usize] {
-        let parent_len = match model.bodies[b].parent {
-            BodyRef::Ground => 0,
-            BodyRef::Body(p) => chains[p].len(),
-        };
-        &chains[b][parent_len..]
-    };
+    let own_coordinates = |b: usize| -> &[usize] { &chains[b][own_range(model, &chains, b)] };
 
     // Composite bodies, division-free (module docs).
     let mut cm: Vec<ExprId> = vec![alg.zero(); nb];
@@ -517,7 +615,10 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
 
     // Mass matrix: momentum (L, H) of the composite subtree for a unit rate of
     // q_i, carried from joint point to joint point up the chain
-    // (H_prev = H + (p_i − p_prev) × L) and projected on each coordinate.
+    // (H_prev = H + (p_i − p_prev) × L) and projected on each coordinate. (The
+    // alternative with every entry independent, M_ki = u_k·H_o − (u_k × (p_k − o))·L
+    // about one point o per tree, was measured 2.5 % slower on chain30: more
+    // operations, and out-of-order execution overlaps the columns' recursions.)
     let mut mass_entries: Vec<((usize, usize), ExprId)> = Vec::new();
     for b in 0..nb {
         let own = own_coordinates(b).to_vec();
@@ -604,13 +705,13 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         (f, alg.add(ia, wiw))
     });
     let gravity_q = project(&mut alg, &|alg, j| {
-        (alg.scale(masses[j], gravity), alg.v_zero())
+        (alg.scale(masses[j], states[j].g), alg.v_zero())
     });
 
     // Kinematics and Jacobians.
     let mut kinematics = Vec::with_capacity(18 * nb);
     let mut jac = Vec::new();
-    for (j, s) in states.iter().enumerate() {
+    for (j, s) in global.states.iter().enumerate() {
         kinematics.extend_from_slice(&s.r);
         for c in 0..3 {
             for r in 0..3 {
@@ -619,8 +720,8 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         }
         kinematics.extend_from_slice(&s.v);
         kinematics.extend_from_slice(&s.w);
-        for &i in &chains[j] {
-            let ax = axes[i].expect("coordinate axis set");
+        for &i in &global.chains[j] {
+            let ax = global.axes[i].expect("coordinate axis set");
             let (lin, ang) = if ax.rotation {
                 let d = alg.sub(s.r, ax.p);
                 (alg.cross(ax.u, d), ax.u)
@@ -654,9 +755,9 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
             match body {
                 BodyRef::Ground => (o, rf, None),
                 BodyRef::Body(b) => {
-                    let ao = alg.mat_vec(&states[b].a, o);
-                    let p = alg.add(states[b].r, ao);
-                    (p, alg.mat_mul(&states[b].a, &rf), Some(b))
+                    let ao = alg.mat_vec(&global.states[b].a, o);
+                    let p = alg.add(global.states[b].r, ao);
+                    (p, alg.mat_mul(&global.states[b].a, &rf), Some(b))
                 }
             }
         };
@@ -666,10 +767,10 @@ pub fn derive(model: &Model, opts: &DeriveOptions) -> Derived {
         // Partial (δP, δθ) of a frame point w.r.t. coordinate i.
         let partial = |alg: &mut Alg, b: Option<usize>, p: V3, i: usize| -> Option<(V3, V3)> {
             let b = b?;
-            if !chains[b].contains(&i) {
+            if !global.chains[b].contains(&i) {
                 return None;
             }
-            let ax = axes[i].expect("coordinate axis set");
+            let ax = global.axes[i].expect("coordinate axis set");
             Some(if ax.rotation {
                 let dd = alg.sub(p, ax.p);
                 (alg.cross(ax.u, dd), ax.u)

@@ -65,6 +65,21 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
                 &model.name,
             );
             close(&es.jacobians, &en.jacobians, "Γ", &model.name);
+            // The dynamics-only program (what the integrator calls most).
+            let mut ed = Evaluation::for_equations(&sym);
+            let dynamics = Parts {
+                gravity: true,
+                ..Parts::MASS_AND_BIAS
+            };
+            sym.evaluate(t, &q, &v, dynamics, &mut ed).unwrap();
+            close(&ed.mass, &en.mass, "M (dynamics only)", &model.name);
+            close_scaled(
+                &col(&ed.bias),
+                &col(&en.bias),
+                k_scale.max(en.bias.abs().max()),
+                "k (dynamics only)",
+                &model.name,
+            );
             for (a, b) in es.bodies.iter().zip(&en.bodies) {
                 let pa = DMatrix::from_iterator(
                     18,
