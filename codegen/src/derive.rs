@@ -267,6 +267,11 @@ struct State {
     /// In the tree-local pass: no generalized coordinate on the path yet
     /// (the vectors are expressed in the current frame; see [`forward`]).
     pre: bool,
+    /// The last rotations on the path, when they share one axis: the axis,
+    /// the rotation before them and their summed angle, so that
+    /// A = A_before · R_axis(Σ angles) (one sine and cosine of the sum instead of a
+    /// matrix product per rotation: planar chains).
+    same_axis: Option<(usize, M3, ExprId)>,
 }
 
 #[derive(Clone, Copy)]
@@ -355,6 +360,7 @@ fn forward(
                 alpha0: alg.v_zero(),
                 g: gravity,
                 pre: local,
+                same_axis: None,
             },
         };
         for el in &body.joint {
@@ -467,8 +473,13 @@ fn forward(
                 let t = alg.add(c, ua);
                 s.alpha0 = alg.add(s.alpha0, t);
                 s.w = alg.add(s.w, w_rel);
-                let r = alg.rotation(axis, val);
-                s.a = alg.mat_mul(&s.a, &r);
+                let (before, angle) = match s.same_axis {
+                    Some((a, before, angle)) if a == axis => (before, alg.ctx.add(angle, val)),
+                    _ => (s.a, val),
+                };
+                let r = alg.rotation(axis, angle);
+                s.a = alg.mat_mul(&before, &r);
+                s.same_axis = Some((axis, before, angle));
             } else {
                 let d = alg.scale(val, u);
                 let v_rel = alg.scale(rate, u);
