@@ -306,6 +306,54 @@ struct Forward {
     op_of: Vec<usize>,
 }
 
+/// Consecutive translations, applied to the velocity and acceleration at once
+/// (at the next rotation or the body's end): while the frame only translates,
+/// its ω and α⁰ stay, so for the summed displacement D, relative velocity V
+/// and relative acceleration A
+///
+/// ```text
+///   v' = v + ω×D + V,   a⁰' = a⁰ + α⁰×D + ω×(ω×D) + 2 ω×V + A
+/// ```
+///
+/// (one set of cross products instead of one per elementary translation: a
+/// body's x, y, z coordinates in a moving frame).
+#[derive(Default)]
+struct Shift {
+    sum: Option<[V3; 3]>,
+}
+
+impl Shift {
+    /// Adds the translation by `val` along `u` (rate, acceleration); returns its displacement.
+    fn add(&mut self, alg: &mut Alg, val: ExprId, rate: ExprId, acc: ExprId, u: V3) -> V3 {
+        let d = alg.scale(val, u);
+        let v = alg.scale(rate, u);
+        let a = alg.scale(acc, u);
+        self.sum = Some(match self.sum {
+            None => [d, v, a],
+            Some([sd, sv, sa]) => [alg.add(sd, d), alg.add(sv, v), alg.add(sa, a)],
+        });
+        d
+    }
+
+    /// Applies the pending translations to `s.v` and `s.acc0`.
+    fn apply(&mut self, alg: &mut Alg, s: &mut State) {
+        let Some([d, v_rel, a_rel]) = self.sum.take() else {
+            return;
+        };
+        let t1 = alg.cross(s.alpha0, d);
+        let wd = alg.cross(s.w, d);
+        let t2 = alg.cross(s.w, wd);
+        let wv = alg.cross(s.w, v_rel);
+        let t3 = alg.scale_num(2.0, wv);
+        let sum = alg.add(t1, t2);
+        let sum = alg.add(sum, t3);
+        let sum = alg.add(sum, a_rel);
+        s.acc0 = alg.add(s.acc0, sum);
+        let dv = alg.add(wd, v_rel);
+        s.v = alg.add(s.v, dv);
+    }
+}
+
 /// The forward pass (see runtime::numeric for the formulas).
 ///
 /// `local == false`: everything in SC0 (body kinematics, Jacobians,
@@ -363,6 +411,7 @@ fn forward(
                 same_axis: None,
             },
         };
+        let mut shift = Shift::default();
         for el in &body.joint {
             let (rotation, axis) = match el.kind {
                 ElementaryKind::Translation(a) => (false, a.index()),
@@ -410,6 +459,7 @@ fn forward(
                 let mut e = alg.v_zero();
                 e[axis] = alg.ctx.num(1.0);
                 if rotation {
+                    shift.apply(alg, &mut s);
                     let w_rel = alg.scale(rate, e);
                     let c = alg.cross(s.w, w_rel);
                     let ua = alg.scale(acc, e);
@@ -425,20 +475,7 @@ fn forward(
                     s.acc0 = alg.mat_vec(&rt, s.acc0);
                     s.g = alg.mat_vec(&rt, s.g);
                 } else {
-                    let d = alg.scale(val, e);
-                    let v_rel = alg.scale(rate, e);
-                    let t1 = alg.cross(s.alpha0, d);
-                    let wd = alg.cross(s.w, d);
-                    let t2 = alg.cross(s.w, wd);
-                    let wv = alg.cross(s.w, v_rel);
-                    let t3 = alg.scale_num(2.0, wv);
-                    let t4 = alg.scale(acc, e);
-                    let sum = alg.add(t1, t2);
-                    let sum = alg.add(sum, t3);
-                    let sum = alg.add(sum, t4);
-                    s.acc0 = alg.add(s.acc0, sum);
-                    let dv = alg.add(wd, v_rel);
-                    s.v = alg.add(s.v, dv);
+                    shift.add(alg, val, rate, acc, e);
                 }
                 f.ops.push(OpNode {
                     parent: last_op,
@@ -467,6 +504,7 @@ fn forward(
             });
             last_op = Some(f.ops.len() - 1);
             if rotation {
+                shift.apply(alg, &mut s);
                 let w_rel = alg.scale(rate, u);
                 let c = alg.cross(s.w, w_rel);
                 let ua = alg.scale(acc, u);
@@ -481,23 +519,11 @@ fn forward(
                 s.a = alg.mat_mul(&before, &r);
                 s.same_axis = Some((axis, before, angle));
             } else {
-                let d = alg.scale(val, u);
-                let v_rel = alg.scale(rate, u);
-                let t1 = alg.cross(s.alpha0, d);
-                let wd = alg.cross(s.w, d);
-                let t2 = alg.cross(s.w, wd);
-                let wv = alg.cross(s.w, v_rel);
-                let t3 = alg.scale_num(2.0, wv);
-                let t4 = alg.scale(acc, u);
-                let sum = alg.add(t1, t2);
-                let sum = alg.add(sum, t3);
-                let sum = alg.add(sum, t4);
-                s.acc0 = alg.add(s.acc0, sum);
-                let dv = alg.add(wd, v_rel);
-                s.v = alg.add(s.v, dv);
+                let d = shift.add(alg, val, rate, acc, u);
                 s.r = alg.add(s.r, d);
             }
         }
+        shift.apply(alg, &mut s);
         let m = expr_to_cas(alg.ctx, &body.mass, opts);
         let iv = body.inertia.clone().map(|e| expr_to_cas(alg.ctx, &e, opts));
         let ib = [
