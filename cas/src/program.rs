@@ -597,44 +597,57 @@ impl Program {
 /// over and the constant left over.
 type SumParts = (Vec<(ExprId, bool)>, Vec<(ExprId, f64)>, f64);
 
+/// `(base, coefficient)` pairs of a sum.
+type Terms = Box<[(ExprId, f64)]>;
+
 /// The sums (of at least two terms) among the nodes being compiled, indexed by term.
 struct SumIndex {
-    /// Per sum: node, constant, number of terms.
-    sums: Vec<(ExprId, f64, usize)>,
+    /// Per sum: node, constant, terms (sorted by base).
+    sums: Vec<(ExprId, f64, Terms)>,
     /// Sum number of each sum node.
     of_node: FxMap<ExprId, u32>,
     /// For each term base: the sums containing it, with its coefficient there.
     by_term: FxMap<ExprId, Vec<(u32, f64)>>,
+    /// Per sum: the search (generation) that last looked at it.
+    seen: Vec<u32>,
+    generation: u32,
 }
 
 impl SumIndex {
     /// At most this many partial sums are taken into one sum.
     const MAX_PARTS: usize = 4;
+    /// Candidate partial sums are looked up through this many of a sum's rarest terms.
+    const PROBES: usize = 8;
 
     fn new(ctx: &Context, order: &[ExprId]) -> Self {
         let mut index = SumIndex {
             sums: Vec::new(),
             of_node: FxMap::default(),
             by_term: FxMap::default(),
+            seen: Vec::new(),
+            generation: 0,
         };
         for &id in order {
             if let Node::Add { constant, terms } = ctx.node(id)
                 && terms.len() >= 2
             {
                 let k = index.sums.len() as u32;
-                index.sums.push((id, *constant, terms.len()));
+                let mut sorted = terms.clone();
+                sorted.sort_unstable_by_key(|&(b, _)| b);
+                index.sums.push((id, *constant, sorted));
                 index.of_node.insert(id, k);
                 for &(base, c) in terms.iter() {
                     index.by_term.entry(base).or_default().push((k, c));
                 }
             }
         }
+        index.seen = vec![0; index.sums.len()];
         index
     }
 
     /// Other sums whose terms are all among `terms` (disjoint from each other), largest first,
     /// each with `true` when it enters negated; and the terms and constant left over.
-    fn parts(&self, id: ExprId, constant: f64, terms: &[(ExprId, f64)]) -> SumParts {
+    fn parts(&mut self, id: ExprId, constant: f64, terms: &[(ExprId, f64)]) -> SumParts {
         let mut rest: Vec<(ExprId, f64)> = terms.to_vec();
         let mut rest_constant = constant;
         let mut parts = Vec::new();
@@ -642,45 +655,57 @@ impl SumIndex {
             return (parts, rest, rest_constant);
         };
         while parts.len() < Self::MAX_PARTS && rest.len() >= 2 {
-            // Per candidate sum: how many of its terms are here with equal / opposite coefficient.
-            let mut hits: FxMap<u32, (usize, usize)> = FxMap::default();
-            for &(base, c) in &rest {
-                for &(k, ck) in self.by_term.get(&base).map_or(&[][..], |v| v) {
-                    if k == me {
+            // `rest` by term, for the subset checks.
+            let mut sorted = rest.clone();
+            sorted.sort_unstable_by_key(|&(b, _)| b);
+            // Candidates: the sums containing one of the rarest terms (short lists). A large
+            // partial sum contains most terms, so it is among them unless it misses all the
+            // probed ones; checking every sum that shares any term would cost O(n⁴) on a
+            // chain's mass matrix.
+            let mut probes: Vec<ExprId> = rest.iter().map(|&(b, _)| b).collect();
+            probes.sort_unstable_by_key(|b| (self.by_term.get(b).map_or(0, Vec::len), *b));
+            probes.truncate(Self::PROBES);
+            self.generation += 1;
+            let mut best: Option<(usize, ExprId, bool, f64)> = None;
+            for base in &probes {
+                for &(k, _) in self.by_term.get(base).map_or(&[][..], |v| v) {
+                    if k == me || self.seen[k as usize] == self.generation {
                         continue;
                     }
-                    let h = hits.entry(k).or_default();
-                    if ck == c {
-                        h.0 += 1;
-                    } else if ck == -c {
-                        h.1 += 1;
+                    self.seen[k as usize] = self.generation;
+                    let (node, kc, ref t_terms) = self.sums[k as usize];
+                    let len = t_terms.len();
+                    let better = best.is_none_or(|b| {
+                        (len, std::cmp::Reverse(node)) > (b.0, std::cmp::Reverse(b.1))
+                    });
+                    if len > rest.len() || !better {
+                        continue;
                     }
-                }
-            }
-            let best = hits
-                .iter()
-                .filter_map(|(&k, &(same, opposite))| {
-                    let (node, kc, len) = self.sums[k as usize];
-                    let negated = if same == len {
-                        false
-                    } else if opposite == len {
-                        true
-                    } else {
-                        return None;
-                    };
+                    let sign =
+                        |&(b, c): &(ExprId, f64)| match sorted.binary_search_by_key(&b, |t| t.0) {
+                            Ok(i) if sorted[i].1 == c => 1,
+                            Ok(i) if sorted[i].1 == -c => -1,
+                            _ => 0,
+                        };
+                    let first = sign(&t_terms[0]);
+                    if first == 0 || !t_terms[1..].iter().all(|t| sign(t) == first) {
+                        continue;
+                    }
+                    let negated = first < 0;
                     let kc = if negated { -kc } else { kc };
                     // The same terms again only as the constant-free sum, so that two sums
                     // never refer to each other (T = −S).
                     let smaller = len < terms.len() || (!negated && kc == 0.0 && constant != 0.0);
-                    (smaller && (kc == 0.0 || kc == rest_constant))
-                        .then_some((len, node, negated, kc))
-                })
-                .max_by_key(|&(len, node, ..)| (len, std::cmp::Reverse(node)));
+                    if smaller && (kc == 0.0 || kc == rest_constant) {
+                        best = Some((len, node, negated, kc));
+                    }
+                }
+            }
             let Some((_, node, negated, kc)) = best else {
                 break;
             };
-            let k = self.of_node[&node];
-            rest.retain(|(base, _)| !self.by_term[base].iter().any(|&(s, _)| s == k));
+            let (_, _, ref t_terms) = self.sums[self.of_node[&node] as usize];
+            rest.retain(|(base, _)| t_terms.binary_search_by_key(base, |t| t.0).is_err());
             rest_constant -= kc;
             parts.push((node, negated));
         }
