@@ -453,37 +453,8 @@ fn forward(
                 // origin is the reference point: r = 0, A = E).
                 s.pre = false;
             }
-            if s.pre {
-                // Still before the first coordinate: the absolute velocities and
-                // accelerations of the current frame, in its own basis.
-                let mut e = alg.v_zero();
-                e[axis] = alg.ctx.num(1.0);
-                if rotation {
-                    shift.apply(alg, &mut s);
-                    let w_rel = alg.scale(rate, e);
-                    let c = alg.cross(s.w, w_rel);
-                    let ua = alg.scale(acc, e);
-                    let t = alg.add(c, ua);
-                    let alpha0 = alg.add(s.alpha0, t);
-                    let w = alg.add(s.w, w_rel);
-                    // New basis: x' = Rᵀ x.
-                    let rt = alg.rotation(axis, val);
-                    let rt = [0, 1, 2].map(|r| [0, 1, 2].map(|c| rt[c][r]));
-                    s.w = alg.mat_vec(&rt, w);
-                    s.alpha0 = alg.mat_vec(&rt, alpha0);
-                    s.v = alg.mat_vec(&rt, s.v);
-                    s.acc0 = alg.mat_vec(&rt, s.acc0);
-                    s.g = alg.mat_vec(&rt, s.g);
-                } else {
-                    shift.add(alg, val, rate, acc, e);
-                }
-                f.ops.push(OpNode {
-                    parent: last_op,
-                    d: None,
-                });
-                last_op = Some(f.ops.len() - 1);
-                continue;
-            }
+            // Before the first coordinate of the local pass A stays E, so `u` is the
+            // current frame's own axis and the vectors are in that frame's basis.
             let u = alg.column(&s.a, axis);
             if let Some(i) = coord {
                 f.axes[i] = Some(AxisInfo {
@@ -493,16 +464,7 @@ fn forward(
                 });
                 f.op_of[i] = f.ops.len();
             }
-            let d_op = if rotation {
-                None
-            } else {
-                Some(alg.scale(val, u))
-            };
-            f.ops.push(OpNode {
-                parent: last_op,
-                d: d_op,
-            });
-            last_op = Some(f.ops.len() - 1);
+            let mut d_op = None;
             if rotation {
                 shift.apply(alg, &mut s);
                 let w_rel = alg.scale(rate, u);
@@ -511,17 +473,34 @@ fn forward(
                 let t = alg.add(c, ua);
                 s.alpha0 = alg.add(s.alpha0, t);
                 s.w = alg.add(s.w, w_rel);
-                let (before, angle) = match s.same_axis {
-                    Some((a, before, angle)) if a == axis => (before, alg.ctx.add(angle, val)),
-                    _ => (s.a, val),
-                };
-                let r = alg.rotation(axis, angle);
-                s.a = alg.mat_mul(&before, &r);
-                s.same_axis = Some((axis, before, angle));
+                if s.pre {
+                    // The rotated frame's basis: x' = Rᵀ x.
+                    let r = alg.rotation(axis, val);
+                    let rt = [0, 1, 2].map(|i| [0, 1, 2].map(|k| r[k][i]));
+                    for x in [&mut s.w, &mut s.alpha0, &mut s.v, &mut s.acc0, &mut s.g] {
+                        *x = alg.mat_vec(&rt, *x);
+                    }
+                } else {
+                    let (before, angle) = match s.same_axis {
+                        Some((a, before, angle)) if a == axis => (before, alg.ctx.add(angle, val)),
+                        _ => (s.a, val),
+                    };
+                    let r = alg.rotation(axis, angle);
+                    s.a = alg.mat_mul(&before, &r);
+                    s.same_axis = Some((axis, before, angle));
+                }
             } else {
                 let d = shift.add(alg, val, rate, acc, u);
-                s.r = alg.add(s.r, d);
+                if !s.pre {
+                    s.r = alg.add(s.r, d);
+                    d_op = Some(d);
+                }
             }
+            f.ops.push(OpNode {
+                parent: last_op,
+                d: d_op,
+            });
+            last_op = Some(f.ops.len() - 1);
         }
         shift.apply(alg, &mut s);
         let m = expr_to_cas(alg.ctx, &body.mass, opts);

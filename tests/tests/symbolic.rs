@@ -43,43 +43,37 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
             }
             num.evaluate(t, &q, &v, Parts::ALL, &mut en).unwrap();
             sym.evaluate(t, &q, &v, Parts::ALL, &mut es).unwrap();
-            close(&es.mass, &en.mass, "M", &model.name);
-            let col =
-                |x: &nalgebra::DVector<f64>| DMatrix::from_column_slice(x.len(), 1, x.as_slice());
-            // Natural scales: inertia forces |M|(1 + |q̇|²), gravity |M|·|g|.
-            let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let k_scale = en.mass.abs().max() * (1.0 + vmax * vmax);
-            close_scaled(
-                &col(&es.bias),
-                &col(&en.bias),
-                k_scale.max(en.bias.abs().max()),
-                "k",
-                &model.name,
-            );
-            let g_scale = en.mass.abs().max() * 9.81;
-            close_scaled(
-                &col(&es.gravity),
-                &col(&en.gravity),
-                g_scale.max(en.gravity.abs().max()),
-                "Q_g",
-                &model.name,
-            );
-            close(&es.jacobians, &en.jacobians, "Γ", &model.name);
-            // The dynamics-only program (what the integrator calls most).
+            // Also the dynamics-only program (what the integrator calls most).
             let mut ed = Evaluation::for_equations(&sym);
             let dynamics = Parts {
                 gravity: true,
                 ..Parts::MASS_AND_BIAS
             };
             sym.evaluate(t, &q, &v, dynamics, &mut ed).unwrap();
-            close(&ed.mass, &en.mass, "M (dynamics only)", &model.name);
-            close_scaled(
-                &col(&ed.bias),
-                &col(&en.bias),
-                k_scale.max(en.bias.abs().max()),
-                "k (dynamics only)",
-                &model.name,
-            );
+            let col =
+                |x: &nalgebra::DVector<f64>| DMatrix::from_column_slice(x.len(), 1, x.as_slice());
+            // Natural scales: inertia forces |M|(1 + |q̇|²), gravity |M|·|g|.
+            let vmax = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let k_scale = en.mass.abs().max() * (1.0 + vmax * vmax);
+            let g_scale = en.mass.abs().max() * 9.81;
+            for (e, program) in [(&es, ""), (&ed, " (dynamics only)")] {
+                close(&e.mass, &en.mass, &format!("M{program}"), &model.name);
+                close_scaled(
+                    &col(&e.bias),
+                    &col(&en.bias),
+                    k_scale.max(en.bias.abs().max()),
+                    &format!("k{program}"),
+                    &model.name,
+                );
+                close_scaled(
+                    &col(&e.gravity),
+                    &col(&en.gravity),
+                    g_scale.max(en.gravity.abs().max()),
+                    &format!("Q_g{program}"),
+                    &model.name,
+                );
+            }
+            close(&es.jacobians, &en.jacobians, "Γ", &model.name);
             for (a, b) in es.bodies.iter().zip(&en.bodies) {
                 let pa = DMatrix::from_iterator(
                     18,
