@@ -466,6 +466,93 @@ impl Program {
         out
     }
 
+    /// The same program with every sin and cos whose argument needs no function call moved into
+    /// one contiguous range of instructions, returned with it; a code generator can then compute
+    /// them in one vectorized batch. The instructions the batched arguments depend on come
+    /// first (in their original order), then the batch (ordered by argument, sin before cos),
+    /// then everything else in its original order, so the program stays in dependency order
+    /// and evaluates to the same values. Trigonometric calls whose argument depends on another
+    /// call (`sin(atan2(y, x))`, say) stay where they are.
+    pub fn batch_sin_cos(&self) -> (Program, Range<usize>) {
+        let n = self.instrs.len();
+        let is_call = |i: &Instr| matches!(i, Instr::Call(..) | Instr::Atan2(..));
+        // after_call[k]: the value of t_k depends on a function call (or is one).
+        let mut after_call = vec![false; n];
+        for (k, i) in self.instrs.iter().enumerate() {
+            let mut c = is_call(i);
+            i.for_each_operand(|o| {
+                if let Operand::Tmp(t) = o {
+                    c |= after_call[t as usize];
+                }
+            });
+            after_call[k] = c;
+        }
+        let batchable = |k: usize| match self.instrs[k] {
+            Instr::Call(Func::Sin | Func::Cos, a) => match a {
+                Operand::Tmp(t) => !after_call[t as usize],
+                _ => true,
+            },
+            _ => false,
+        };
+        // Instructions the batched arguments need (all call-free), found backwards.
+        let mut needed = vec![false; n];
+        for k in (0..n).rev() {
+            if needed[k] || batchable(k) {
+                self.instrs[k].for_each_operand(|o| {
+                    if let Operand::Tmp(t) = o {
+                        needed[t as usize] = true;
+                    }
+                });
+            }
+        }
+        // The batch, grouped by argument in order of first appearance, sin before cos.
+        let mut arg_rank: FxMap<OpKey, usize> = FxMap::default();
+        let mut batch: Vec<(usize, bool, usize)> = Vec::new();
+        for k in (0..n).filter(|&k| batchable(k)) {
+            let Instr::Call(f, a) = self.instrs[k] else {
+                unreachable!("batchable instructions are sin or cos calls")
+            };
+            let next = arg_rank.len();
+            let rank = *arg_rank.entry(key(a)).or_insert(next);
+            batch.push((rank, f == Func::Cos, k));
+        }
+        batch.sort_unstable();
+        let mut order: Vec<usize> = (0..n).filter(|&k| needed[k]).collect();
+        let start = order.len();
+        order.extend(batch.iter().map(|&(_, _, k)| k));
+        let end = order.len();
+        let mut placed = vec![false; n];
+        for &k in &order {
+            placed[k] = true;
+        }
+        order.extend((0..n).filter(|&k| !placed[k]));
+        let mut new_index = vec![0u32; n];
+        for (new, &old) in order.iter().enumerate() {
+            new_index[old] = new as u32;
+        }
+        let remap = |o: Operand| match o {
+            Operand::Tmp(t) => Operand::Tmp(new_index[t as usize]),
+            other => other,
+        };
+        let instrs = order
+            .iter()
+            .map(|&old| match self.instrs[old] {
+                Instr::Add(a, b) => Instr::Add(remap(a), remap(b)),
+                Instr::Sub(a, b) => Instr::Sub(remap(a), remap(b)),
+                Instr::Mul(a, b) => Instr::Mul(remap(a), remap(b)),
+                Instr::Div(a, b) => Instr::Div(remap(a), remap(b)),
+                Instr::Atan2(a, b) => Instr::Atan2(remap(a), remap(b)),
+                Instr::Neg(a) => Instr::Neg(remap(a)),
+                Instr::Call(f, a) => Instr::Call(f, remap(a)),
+            })
+            .collect();
+        let program = Program {
+            instrs,
+            outputs: self.outputs.iter().map(|&o| remap(o)).collect(),
+        };
+        (program, start..end)
+    }
+
     /// For each temporary, the index of the last instruction reading it, or `instrs.len()` if
     /// it is an output (live to the end).
     pub fn last_uses(&self) -> Vec<usize> {
@@ -513,14 +600,43 @@ impl Program {
     /// defining chunk stores them into a slot, later chunks load them from it. Slots are reused
     /// once a temporary is dead (greedy allocation in chunk order).
     pub fn split(&self, max_instrs: usize) -> Result<SplitProgram, CasError> {
+        self.split_keeping(max_instrs, 0..0)
+    }
+
+    /// [`Program::split`], but the instructions of `together` (such as the range of
+    /// [`Program::batch_sin_cos`]) end up in one chunk: a chunk that would end inside it ends
+    /// before it instead, or, if it starts there, grows to its end.
+    pub fn split_keeping(
+        &self,
+        max_instrs: usize,
+        together: Range<usize>,
+    ) -> Result<SplitProgram, CasError> {
         if max_instrs == 0 {
             return Err(CasError::InvalidArgument(
                 "split: max_instrs must be at least 1".to_string(),
             ));
         }
         let n = self.instrs.len();
-        let n_chunks = n.div_ceil(max_instrs);
-        let chunk_of = |k: usize| k / max_instrs;
+        let mut bounds = Vec::new();
+        let mut start = 0;
+        while start < n {
+            let mut end = (start + max_instrs).min(n);
+            if together.start < end && end < together.end {
+                end = if together.start > start {
+                    together.start
+                } else {
+                    together.end
+                };
+            }
+            bounds.push(start..end);
+            start = end;
+        }
+        let n_chunks = bounds.len();
+        let mut chunk_index = vec![0u32; n];
+        for (c, r) in bounds.iter().enumerate() {
+            chunk_index[r.clone()].fill(c as u32);
+        }
+        let chunk_of = |k: usize| chunk_index[k] as usize;
         // Last chunk using each temporary (n_chunks = an output).
         let mut last_chunk: Vec<usize> = (0..n).map(chunk_of).collect();
         for (k, i) in self.instrs.iter().enumerate() {
@@ -542,8 +658,7 @@ impl Program {
         // chunk that last loaded each temporary (dedup of loads in O(1))
         let mut loaded_in: Vec<usize> = vec![usize::MAX; n];
         let mut chunks = Vec::with_capacity(n_chunks);
-        for c in 0..n_chunks {
-            let range = c * max_instrs..((c + 1) * max_instrs).min(n);
+        for (c, range) in bounds.into_iter().enumerate() {
             active.retain(|&(l, s)| {
                 if l < c {
                     free.push(s);
@@ -588,6 +703,7 @@ impl Program {
             chunks,
             n_slots: n_slots as usize,
             slot_of_tmp,
+            chunk_index,
         })
     }
 }
@@ -820,9 +936,16 @@ pub struct SplitProgram {
     pub n_slots: usize,
     /// Scratch slot of each temporary that crosses a chunk boundary (`None`: local to its chunk).
     pub slot_of_tmp: Vec<Option<u32>>,
+    /// The chunk of each instruction.
+    chunk_index: Vec<u32>,
 }
 
 impl SplitProgram {
+    /// The chunk that computes instruction `k`.
+    pub fn chunk_of(&self, k: usize) -> usize {
+        self.chunk_index[k] as usize
+    }
+
     /// Evaluates `prog` chunk by chunk, each chunk seeing only its own temporaries and its
     /// loads (as generated code would), to check the split.
     pub fn eval(&self, prog: &Program, values: &Values) -> Result<Vec<f64>, CasError> {

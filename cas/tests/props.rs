@@ -13,7 +13,7 @@
 //! Trees have at most ~60 operations; 1e-12·M ≈ 4500 ε·M leaves a wide margin.
 
 use proptest::prelude::*;
-use railmbs_cas::{Context, ExprId, ONE, Operand, Program, Symbol, Values};
+use railmbs_cas::{Context, ExprId, Func, Instr, ONE, Operand, Program, Symbol, Values};
 
 #[derive(Clone, Debug)]
 enum T {
@@ -362,6 +362,25 @@ proptest! {
         for max in [1usize, 3, 16] {
             let sp = prog.split(max).unwrap();
             prop_assert_eq!(&sp.eval(&prog, &vals).unwrap(), &got);
+        }
+        // moving the call-free sin and cos into one batch reorders, never changes, instructions:
+        // bit-equal again, the batch is sin/cos of call-free arguments, and every split keeps
+        // it in one chunk
+        let (batched, range) = prog.batch_sin_cos();
+        prop_assert_eq!(batched.instrs.len(), prog.instrs.len());
+        prop_assert_eq!(&batched.eval(&vals).unwrap(), &got);
+        for k in range.clone() {
+            let is_trig = matches!(batched.instrs[k], Instr::Call(Func::Sin | Func::Cos, _));
+            prop_assert!(is_trig, "t{k} in the batch {range:?} of\n{batched}");
+        }
+        let n_trig = prog.instrs.iter().filter(|i| matches!(i, Instr::Call(Func::Sin | Func::Cos, Operand::Sym(_) | Operand::Const(_)))).count();
+        prop_assert!(range.len() >= n_trig, "sin/cos of inputs left out of the batch {range:?} of\n{batched}");
+        for max in [1usize, 3, 16] {
+            let sp = batched.split_keeping(max, range.clone()).unwrap();
+            if !range.is_empty() {
+                prop_assert_eq!(sp.chunk_of(range.start), sp.chunk_of(range.end - 1));
+            }
+            prop_assert_eq!(&sp.eval(&batched, &vals).unwrap(), &got);
         }
         // topological order and liveness: every read is of an earlier temporary, at or before
         // its recorded last use; outputs live to the end
