@@ -25,7 +25,8 @@
 //!
 //! # Cache
 //!
-//! The key is a BLAKE3 hash of (source, `rustc -vV` output, flags, caller's ABI version); the
+//! The key is a BLAKE3 hash of (source, `rustc -vV` output, `rustc --print cfg` for the
+//! target-selecting flags, flags, caller's ABI version); the
 //! library is `<cache>/<prefix>railmbs_plugin_<hash><suffix>` (e.g. `librailmbs_plugin_…so`).
 //! The cache directory is [`resolve_cache_dir`]: [`BuildOptions::cache_dir`], else
 //! `RAILMBS_CACHE_DIR`, else the platform cache directory + `railmbs/plugins`.
@@ -105,7 +106,7 @@ pub const EDITION: &str = "2021";
 pub const DEFAULT_CODEGEN_UNITS: u32 = 16;
 
 /// Version of the cache-key layout; bump it when the key's meaning changes.
-const KEY_VERSION: &str = "railmbs-build-support plugin key v1";
+const KEY_VERSION: &str = "railmbs-build-support plugin key v2";
 
 /// Flags a caller may not pass in [`BuildOptions::extra_flags`]: this crate sets them itself.
 const RESERVED_FLAGS: [&str; 6] = [
@@ -254,7 +255,15 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
     // Absolute, so that paths in errors and diagnostics are unambiguous.
     let cache = std::path::absolute(&cache).map_err(|e| BuildError::io(&cache, e))?;
     let flags = options.flags();
-    let hash = cache_key(source, &rustc.version, &flags, options.abi_version);
+    // The target description joins the version: with `-C target-cpu=native` it names the
+    // CPU features of this machine (see `Rustc::target_cfg`).
+    let target = rustc.target_cfg(&flags)?;
+    let hash = cache_key(
+        source,
+        &format!("{}\n{target}", rustc.version),
+        &flags,
+        options.abi_version,
+    );
     let crate_name = format!("railmbs_plugin_{hash}");
     let lib_name = format!(
         "{}{crate_name}{}",

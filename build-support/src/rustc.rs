@@ -28,6 +28,60 @@ impl Rustc {
     }
 }
 
+impl Rustc {
+    /// What `rustc --print cfg` says about the target for the target-selecting flags among
+    /// `flags` (`-C target-cpu=…`, `-C target-feature=…`, `--target …`), memoized per rustc and
+    /// flags. With `-C target-cpu=native` the answer names this machine's CPU features, so a
+    /// cache key including it never hands one machine a library built for another's CPU (a
+    /// cache directory shared over the network, say).
+    pub fn target_cfg(&self, flags: &[String]) -> Result<String, BuildError> {
+        type TargetCfgCache = Mutex<HashMap<(PathBuf, Vec<String>), String>>;
+        static CACHE: OnceLock<TargetCfgCache> = OnceLock::new();
+        let mut args = Vec::new();
+        let mut it = flags.iter().peekable();
+        while let Some(f) = it.next() {
+            let value = match f.as_str() {
+                "-C" | "--target" => it.peek().map(|v| v.as_str()),
+                _ => None,
+            };
+            let selects =
+                |v: &str| v.starts_with("target-cpu=") || v.starts_with("target-feature=");
+            match (f.as_str(), value) {
+                ("-C", Some(v)) if selects(v) => args.extend([f.clone(), v.to_owned()]),
+                ("--target", Some(v)) => args.extend([f.clone(), v.to_owned()]),
+                (g, _) if g.starts_with("-C") && selects(&g[2..]) => args.push(f.clone()),
+                (g, _) if g.starts_with("--target=") => args.push(f.clone()),
+                _ => {}
+            }
+        }
+        let key = (self.path.clone(), args.clone());
+        let cache = CACHE.get_or_init(Default::default);
+        if let Some(v) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+            return Ok(v.clone());
+        }
+        let out = Command::new(&self.path)
+            .args(["--print", "cfg"])
+            .args(&args)
+            .output()
+            .map_err(|e| BuildError::RustcNotFound {
+                reason: format!("`{}` could not be started: {e}", self.path.display()),
+            })?;
+        if !out.status.success() {
+            return Err(BuildError::InvalidOption(format!(
+                "`rustc --print cfg {}` failed: {}",
+                args.join(" "),
+                String::from_utf8_lossy(&out.stderr).trim()
+            )));
+        }
+        let cfg = String::from_utf8_lossy(&out.stdout).into_owned();
+        cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(key, cfg.clone());
+        Ok(cfg)
+    }
+}
+
 /// Finds rustc: `explicit` if given, else the `RUSTC` environment variable, else `rustc` on `PATH`.
 ///
 /// An explicit path or a set `RUSTC` that does not work is an error; there is no silent
@@ -111,6 +165,33 @@ mod tests {
         let var = std::env::join_paths([Path::new("/nonexistent-railmbs"), dir.path()]).unwrap();
         assert_eq!(search_path(Some(var)), Some(exe));
         assert_eq!(search_path(None), None);
+    }
+
+    #[test]
+    fn target_cfg_depends_only_on_target_selecting_flags() {
+        let rustc = find_rustc(None).unwrap();
+        let flags = |f: &[&str]| f.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let base = rustc.target_cfg(&[]).unwrap();
+        assert!(base.contains("target_arch="), "{base}");
+        assert_eq!(
+            rustc
+                .target_cfg(&flags(&["-C", "opt-level=2", "--cap-lints", "allow"]))
+                .unwrap(),
+            base
+        );
+        // Naming the CPU changes the description exactly as rustc says it does.
+        let native = rustc
+            .target_cfg(&flags(&["-C", "target-cpu=native"]))
+            .unwrap();
+        let glued = rustc.target_cfg(&flags(&["-Ctarget-cpu=native"])).unwrap();
+        assert_eq!(native, glued);
+        if cfg!(target_arch = "x86_64") {
+            assert!(!base.contains("target_feature=\"avx\""), "{base}");
+            let v3 = rustc
+                .target_cfg(&flags(&["-C", "target-cpu=x86-64-v3"]))
+                .unwrap();
+            assert!(v3.contains("target_feature=\"avx2\""), "{v3}");
+        }
     }
 
     #[test]

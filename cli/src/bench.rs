@@ -31,7 +31,7 @@
 //! (build time of the engine minus derivation and emission: the rustc run, or
 //! about zero on a plugin-cache hit).
 
-use crate::engine::{Engine, build_engine};
+use crate::engine::{Engine, build_engine, build_engine_with};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::{Model, Scenario};
 use railmbs_runtime::simulate::run_scenario;
@@ -134,6 +134,10 @@ pub struct Args {
     /// `mueller` or `polach`.
     #[arg(long)]
     pub creep: Option<String>,
+    /// Build the plugin for any CPU of this architecture instead of this machine's
+    /// (`umgen --portable`), to measure what the native CPU features bring.
+    #[arg(long)]
+    pub portable: bool,
 }
 
 /// Parses `--creep`.
@@ -658,7 +662,7 @@ fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>>
         add(&mut numeric_sum, Some(e));
         if args.engine != BenchEngine::Numeric {
             let start = Instant::now();
-            match build_engine(model, Engine::Symbolic, None) {
+            match build_engine_with(model, Engine::Symbolic, None, args.portable) {
                 Err(e) => {
                     symbolic.note = Some(format!("unavailable: {e}"));
                     symbolic_sum = None;
@@ -675,8 +679,10 @@ fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>>
                         &mut compile_s,
                         Some((build_s - d - g.emit_time.as_secs_f64()).max(0.0)),
                     );
-                    let make =
-                        || build_engine(model, Engine::Symbolic, None).map_err(|e| e.to_string());
+                    let make = || {
+                        build_engine_with(model, Engine::Symbolic, None, args.portable)
+                            .map_err(|e| e.to_string())
+                    };
                     add(
                         &mut symbolic_sum,
                         Some(time_engine(model, &params, &states, &make)?.0),
@@ -696,8 +702,9 @@ fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>>
         (derive_s, compile_s) = (None, None);
     } else if symbolic.note.is_none() {
         symbolic.eval_ns = symbolic_sum;
-        let (t, n) = time_train_run(&train, &models, &|m| {
-            build_engine(m, Engine::Symbolic, None).map_err(|e| e.to_string())
+        let portable = args.portable;
+        let (t, n) = time_train_run(&train, &models, &move |m| {
+            build_engine_with(m, Engine::Symbolic, None, portable).map_err(|e| e.to_string())
         })?;
         symbolic.run_s = Some(t);
         symbolic.run_steps = Some(n);
@@ -805,7 +812,7 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
         symbolic.note = Some("not requested (--engine numeric)".into());
     } else {
         let start = Instant::now();
-        let first = build_engine(&model, Engine::Symbolic, None);
+        let first = build_engine_with(&model, Engine::Symbolic, None, args.portable);
         let build_s = start.elapsed().as_secs_f64();
         match first {
             Err(e) => symbolic.note = Some(format!("unavailable: {e}")),
@@ -818,8 +825,10 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
                 derive_s = Some(d);
                 compile_s = Some((build_s - d - emit).max(0.0));
                 // Later engines come from the plugin cache.
-                let make =
-                    || build_engine(&model, Engine::Symbolic, None).map_err(|e| e.to_string());
+                let make = || {
+                    build_engine_with(&model, Engine::Symbolic, None, args.portable)
+                        .map_err(|e| e.to_string())
+                };
                 match time_engine(&model, &params, &states, &make) {
                     Ok((e, dy)) => {
                         symbolic.eval_ns = Some(e);

@@ -15,13 +15,15 @@ pub enum Engine {
     Symbolic,
 }
 
-/// Generates and compiles (through the plugin cache) the plugin of `model`.
-pub fn build_symbolic(model: &Model) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
-    Ok(railmbs_codegen::build_plugin(
-        model,
-        &GenerateOptions::new(ABI_VERSION),
-        None,
-    )?)
+/// Generates and compiles (through the plugin cache) the plugin of `model`, for this
+/// machine's CPU unless `portable` (see `GenerateOptions::portable`).
+pub fn build_symbolic(
+    model: &Model,
+    portable: bool,
+) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
+    let mut opts = GenerateOptions::new(ABI_VERSION);
+    opts.portable = portable;
+    Ok(railmbs_codegen::build_plugin(model, &opts, None)?)
 }
 
 /// Builds the engine for `model`. The symbolic engine loads `plugin` (checked
@@ -31,12 +33,22 @@ pub fn build_engine(
     engine: Engine,
     plugin: Option<&Path>,
 ) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
+    build_engine_with(model, engine, plugin, false)
+}
+
+/// [`build_engine`], building a portable plugin if `portable` (and no `plugin` is given).
+pub fn build_engine_with(
+    model: &Model,
+    engine: Engine,
+    plugin: Option<&Path>,
+    portable: bool,
+) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
     match engine {
         Engine::Numeric => Ok(Box::new(NumericEquations::new(model))),
         Engine::Symbolic => {
             let path = match plugin {
                 Some(p) => p.to_path_buf(),
-                None => build_symbolic(model)?.path,
+                None => build_symbolic(model, portable)?.path,
             };
             let plugin = Plugin::load_for(&path, model)?;
             Ok(Box::new(PluginEquations::new(plugin)))

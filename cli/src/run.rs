@@ -88,7 +88,9 @@ fn run_train(
                 let plugin = match (engine, &args.plugin) {
                     (Engine::Numeric, _) => None,
                     (Engine::Symbolic, Some(p)) => Some(p.clone()),
-                    (Engine::Symbolic, None) => Some(crate::engine::build_symbolic(&model)?.path),
+                    (Engine::Symbolic, None) => {
+                        Some(crate::engine::build_symbolic(&model, false)?.path)
+                    }
                 };
                 files.push((v.model.clone(), model, plugin));
                 files.len() - 1

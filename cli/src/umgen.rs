@@ -28,6 +28,11 @@ pub struct Args {
     /// Largest number of instructions per generated function.
     #[arg(long, default_value_t = 600)]
     pub max_function_size: usize,
+    /// Compile for any CPU of this architecture, not only this machine's (on x86-64 the
+    /// default is `-C target-cpu=native`; such a plugin is refused on a CPU lacking one of
+    /// its features).
+    #[arg(long)]
+    pub portable: bool,
 }
 
 /// Runs `umgen`.
@@ -36,6 +41,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut opts = GenerateOptions::new(ABI_VERSION);
     opts.fixed = args.fixed.clone();
     opts.max_instructions_per_function = args.max_function_size.max(1);
+    opts.portable = args.portable;
     let built = railmbs_codegen::build_plugin(&model, &opts, None)?;
     let g = &built.generated;
     if let Some(dir) = &args.emit_source {

@@ -33,6 +33,26 @@ pub(crate) struct Unit {
     pub name: &'static str,
     pub program: Program,
     pub targets: Vec<Target>,
+    /// Instructions of `program` computed by one `sin_cos_batch` call
+    /// ([`Program::batch_sin_cos`]).
+    pub trig_batch: std::ops::Range<usize>,
+}
+
+impl Unit {
+    fn new(
+        name: &'static str,
+        ctx: &railmbs_cas::Context,
+        outputs: &[railmbs_cas::ExprId],
+        targets: Vec<Target>,
+    ) -> Unit {
+        let (program, trig_batch) = Program::compile(ctx, outputs).batch_sin_cos();
+        Unit {
+            name,
+            program,
+            targets,
+            trig_batch,
+        }
+    }
 }
 
 /// Statistics for `umgen`.
@@ -53,6 +73,40 @@ pub struct EmitStats {
     /// Time of writing and formatting the Rust source.
     pub format_time: std::time::Duration,
 }
+
+/// x86 target features a plugin reports as compiled in (`railmbs_target_features`), so that
+/// the loader can refuse a plugin built with `-C target-cpu=native` on a machine whose CPU
+/// lacks one, instead of crashing on an illegal instruction. These are the features LLVM may
+/// use by itself in straight-line f64 code (vector widths, FMA, bit manipulation); every one
+/// is detectable by `is_x86_feature_detected!` in `railmbs_runtime::plugin` (a test checks).
+pub const REPORTED_TARGET_FEATURES: [&str; 26] = [
+    "sse3",
+    "ssse3",
+    "sse4.1",
+    "sse4.2",
+    "sse4a",
+    "popcnt",
+    "lzcnt",
+    "bmi1",
+    "bmi2",
+    "movbe",
+    "f16c",
+    "fma",
+    "avx",
+    "avx2",
+    "avx512f",
+    "avx512dq",
+    "avx512cd",
+    "avx512bw",
+    "avx512vl",
+    "avx512ifma",
+    "avx512vbmi",
+    "avx512vbmi2",
+    "avx512vnni",
+    "avx512bitalg",
+    "avx512vpopcntdq",
+    "avx512bf16",
+];
 
 /// Identity of the generated plugin.
 pub struct PluginHeader<'a> {
@@ -99,21 +153,9 @@ pub(crate) fn units(d: &Derived) -> Vec<Unit> {
     let mut all_t = dyn_t.clone();
     all_t.extend_from_slice(&kin_t);
     let mut units = vec![
-        Unit {
-            name: "dyn",
-            program: Program::compile(&d.ctx, &dyn_out),
-            targets: dyn_t,
-        },
-        Unit {
-            name: "kin",
-            program: Program::compile(&d.ctx, &kin_out),
-            targets: kin_t,
-        },
-        Unit {
-            name: "all",
-            program: Program::compile(&d.ctx, &all_out),
-            targets: all_t,
-        },
+        Unit::new("dyn", &d.ctx, &dyn_out, dyn_t),
+        Unit::new("kin", &d.ctx, &kin_out, kin_t),
+        Unit::new("all", &d.ctx, &all_out, all_t),
     ];
     if !d.constraints.is_empty() {
         let nc = d.constraints.len();
@@ -131,11 +173,7 @@ pub(crate) fn units(d: &Derived) -> Vec<Unit> {
             out.push(*e);
             t.push(Target::ConstraintJacobian(c * nc + r));
         }
-        units.push(Unit {
-            name: "con",
-            program: Program::compile(&d.ctx, &out),
-            targets: t,
-        });
+        units.push(Unit::new("con", &d.ctx, &out, t));
     }
     let _ = n;
     units
@@ -211,6 +249,36 @@ fn instr(i: &Instr, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
     }
 }
 
+/// The batch of sin and cos calls `range` of `prog` (all `Call(Sin | Cos, _)`): one
+/// `sin_cos_batch` call over their distinct arguments, then one `let` per instruction.
+fn trig_batch(
+    prog: &Program,
+    range: std::ops::Range<usize>,
+    local: &dyn Fn(u32) -> TokenStream,
+) -> TokenStream {
+    let mut args: Vec<Operand> = Vec::new();
+    let mut lets = Vec::new();
+    for k in range {
+        let Instr::Call(f, a) = prog.instrs[k] else {
+            unreachable!("the batch holds only sin and cos calls")
+        };
+        let i = args.iter().position(|&x| x == a).unwrap_or_else(|| {
+            args.push(a);
+            args.len() - 1
+        });
+        let id = format_ident!("t{}", k);
+        lets.push(match f {
+            CasFunc::Sin => quote!(let #id = trig_sin[#i];),
+            _ => quote!(let #id = trig_cos[#i];),
+        });
+    }
+    let args = args.iter().map(|&a| operand(a, local));
+    quote! {
+        let (trig_sin, trig_cos) = sin_cos_batch(&[#(#args),*]);
+        #(#lets)*
+    }
+}
+
 /// Statements writing one program output into its buffer.
 fn store(target: Target, value: TokenStream, n: usize) -> TokenStream {
     match target {
@@ -268,8 +336,9 @@ fn emit_unit(
     functions: &mut usize,
 ) -> TokenStream {
     let prog = &unit.program;
+    let batch = unit.trig_batch.clone();
     let split = prog
-        .split(max_instrs.max(1))
+        .split_keeping(max_instrs.max(1), batch.clone())
         .expect("max_instrs is at least 1");
     let n_slots = split.n_slots.max(1);
     let mut fns = Vec::new();
@@ -280,21 +349,17 @@ fn emit_unit(
     let mut final_writes = Vec::new();
     for (oi, out) in prog.outputs.iter().enumerate() {
         match out {
-            Operand::Tmp(k) => {
-                let c = (*k as usize) / max_instrs.max(1);
-                writes_in_chunk[c].push((oi, *k));
-            }
+            Operand::Tmp(k) => writes_in_chunk[split.chunk_of(*k as usize)].push((oi, *k)),
             other => final_writes.push((oi, *other)),
         }
     }
-    // sin and cos of the same argument in one chunk: one `sin_cos` call at the
-    // first of the two instructions.
+    // sin and cos of the same argument in one chunk, outside the batch: one
+    // `sin_cos` call at the first of the two instructions.
     let mut fused_first: std::collections::HashMap<usize, (usize, usize)> = Default::default();
     let mut fused_skip: std::collections::HashSet<usize> = Default::default();
-    let chunk_of = |k: usize| k / max_instrs.max(1);
     for (si, ci) in prog.sin_cos_pairs() {
         let (si, ci) = (si as usize, ci as usize);
-        if chunk_of(si) == chunk_of(ci) {
+        if split.chunk_of(si) == split.chunk_of(ci) && !batch.contains(&si) {
             fused_first.insert(si.min(ci), (si, ci));
             fused_skip.insert(si.max(ci));
         }
@@ -319,8 +384,11 @@ fn emit_unit(
         let body = chunk
             .instrs
             .clone()
-            .filter(|k| !fused_skip.contains(k))
+            .filter(|k| !fused_skip.contains(k) && (!batch.contains(k) || *k == batch.start))
             .map(|k| {
+                if k == batch.start && !batch.is_empty() {
+                    return trig_batch(prog, batch.clone(), &local);
+                }
                 if let Some(&(si, cj)) = fused_first.get(&k) {
                     let (sid, cid) = (format_ident!("t{}", si), format_ident!("t{}", cj));
                     let Instr::Call(_, a) = prog.instrs[k] else {
@@ -484,6 +552,16 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let fixed_val: Vec<TokenStream> = header.fixed.iter().map(|&(_, x)| lit(x)).collect();
     let (mass_len, bias_len, kin_len, jac_len, con_len, cjac_len) =
         (n * n, n, 18 * nb, 6 * nb * n, nc, nc * n);
+    let n_features = REPORTED_TARGET_FEATURES.len();
+    let features_cap: usize = REPORTED_TARGET_FEATURES
+        .iter()
+        .map(|f| f.len() + 1)
+        .sum::<usize>()
+        + 1;
+    let feature_names = REPORTED_TARGET_FEATURES.iter();
+    let feature_bytes = REPORTED_TARGET_FEATURES
+        .iter()
+        .map(|f| Literal::byte_string(f.as_bytes()));
     let tokens = quote! {
         //! Generated by railmbs `umgen`: the equations of motion of one model as
         //! straight-line code. Do not edit; regenerate from the model file.
@@ -553,6 +631,39 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
         static FIXED_VALUES: [f64; #nfixed] = [#(#fixed_val),*];
 
         #(#bodies)*
+
+        /// The target features this library was compiled with, among the ones the loader
+        /// checks: a NUL-terminated, comma-separated list (possibly empty), built at compile
+        /// time from `cfg!(target_feature)`.
+        static TARGET_FEATURES: [u8; #features_cap] = {
+            const NAMES: [(&[u8], bool); #n_features] = [#((#feature_bytes, cfg!(target_feature = #feature_names))),*];
+            let mut out = [0u8; #features_cap];
+            let mut len = 0;
+            let mut i = 0;
+            while i < NAMES.len() {
+                if NAMES[i].1 {
+                    if len > 0 {
+                        out[len] = b',';
+                        len += 1;
+                    }
+                    let mut j = 0;
+                    while j < NAMES[i].0.len() {
+                        out[len] = NAMES[i].0[j];
+                        len += 1;
+                        j += 1;
+                    }
+                }
+                i += 1;
+            }
+            out
+        };
+
+        /// Target features compiled in (see `TARGET_FEATURES`). Runs no vector instruction,
+        /// so the loader may call it before knowing whether this CPU can run the rest.
+        #[no_mangle]
+        pub extern "C" fn railmbs_target_features() -> *const c_char {
+            TARGET_FEATURES.as_ptr() as *const c_char
+        }
 
         /// Fills `info`. Safety: `info` points to a writable `PluginInfo`.
         #[no_mangle]
@@ -631,7 +742,9 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
         }
     };
     let file: syn::File = syn::parse2(tokens).expect("generated code parses");
-    let text = prettyplease::unparse(&file);
+    let mut text = prettyplease::unparse(&file);
+    text.push('\n');
+    text.push_str(crate::sin_cos::SOURCE);
     stats.source_lines = text.lines().count();
     stats.format_time = start.elapsed();
     (text, stats)

@@ -5,6 +5,10 @@
 //!
 //! - `railmbs_plugin_info(*mut PluginInfo)`: ABI version, model hash, counts and
 //!   names (NUL-separated lists ending with an empty name), fixed parameters;
+//! - `railmbs_target_features() -> *const c_char`: the x86 target features the
+//!   library was compiled with (comma-separated); plugins are built with
+//!   `-C target-cpu=native` by default, and the loader refuses one that needs a
+//!   feature this CPU lacks before running any of its code that might use it;
 //! - `railmbs_evaluate(*const Inputs, parts: u32, *const Outputs) -> i32`:
 //!   writes the requested parts (bit 1: M, k, Q_g; bit 2: body kinematics and
 //!   Jacobians Γ; bit 4: constraints g and G) into host-owned buffers and
@@ -27,7 +31,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the plugin interface. Bump on any change of the structs or
 /// functions below (or of their meaning).
-pub const ABI_VERSION: u32 = 1;
+pub const ABI_VERSION: u32 = 2;
 
 const PART_DYNAMICS: u32 = 1;
 const PART_KINEMATICS: u32 = 2;
@@ -75,6 +79,7 @@ pub struct Outputs {
 }
 
 type InfoFn = unsafe extern "C" fn(*mut PluginInfo);
+type TargetFeaturesFn = unsafe extern "C" fn() -> *const c_char;
 type EvaluateFn = unsafe extern "C" fn(*const Inputs, u32, *const Outputs) -> i32;
 
 /// Why a plugin cannot be used.
@@ -103,6 +108,87 @@ pub enum PluginError {
         model: String,
         model_hash: String,
     },
+    #[error(
+        "{path}: plugin was compiled for CPU features this machine lacks ({}); rebuild it on \
+         this machine with `umgen`, or build plugins for several machines with `umgen --portable`",
+        missing.join(", ")
+    )]
+    CpuFeatures { path: PathBuf, missing: Vec<String> },
+}
+
+/// Whether this CPU has the target feature `name` (rustc's name, e.g. `avx2`): `None` if
+/// the loader cannot tell (a name it does not know, or not an x86-64 machine).
+pub fn host_has_target_feature(name: &str) -> Option<bool> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        macro_rules! detect {
+            ($($f:tt),*) => {
+                match name {
+                    $($f => Some(std::arch::is_x86_feature_detected!($f)),)*
+                    _ => None,
+                }
+            };
+        }
+        detect!(
+            "sse3",
+            "ssse3",
+            "sse4.1",
+            "sse4.2",
+            "sse4a",
+            "popcnt",
+            "lzcnt",
+            "bmi1",
+            "bmi2",
+            "movbe",
+            "f16c",
+            "fma",
+            "avx",
+            "avx2",
+            "avx512f",
+            "avx512dq",
+            "avx512cd",
+            "avx512bw",
+            "avx512vl",
+            "avx512ifma",
+            "avx512vbmi",
+            "avx512vbmi2",
+            "avx512vnni",
+            "avx512bitalg",
+            "avx512vpopcntdq",
+            "avx512bf16",
+            "aes",
+            "pclmulqdq",
+            "sha",
+            "adx",
+            "gfni",
+            "vaes",
+            "vpclmulqdq",
+            "rdrand",
+            "rdseed",
+            "xsave",
+            "xsaveopt",
+            "xsavec",
+            "xsaves",
+            "cmpxchg16b",
+            "fxsr",
+            "sse",
+            "sse2"
+        )
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = name;
+        None
+    }
+}
+
+/// The features of a plugin's `railmbs_target_features` list this CPU lacks or cannot confirm.
+fn missing_target_features(list: &str) -> Vec<String> {
+    list.split(',')
+        .map(str::trim)
+        .filter(|f| !f.is_empty() && host_has_target_feature(f) != Some(true))
+        .map(str::to_owned)
+        .collect()
 }
 
 fn c_str(p: *const c_char) -> String {
@@ -136,6 +222,8 @@ fn c_str_list(p: *const c_char, count: usize) -> Vec<String> {
 pub struct Plugin {
     path: PathBuf,
     evaluate: EvaluateFn,
+    /// The CPU features the library was compiled with (`railmbs_target_features`).
+    pub target_features: Vec<String>,
     pub dof: usize,
     pub bodies: usize,
     pub constraints: usize,
@@ -166,6 +254,29 @@ impl Plugin {
             path: path.to_path_buf(),
             symbol: symbol.to_string(),
         };
+        // The CPU check comes first: `railmbs_target_features` only returns a
+        // pointer, every other function may use the features it lists. A library
+        // without it is from ABI 1 (built without native features): its version
+        // check below says so.
+        let mut target_features: Option<Vec<String>> = None;
+        // SAFETY: the signature is that of the ABI; the function reads nothing.
+        if let Ok(features) = unsafe { lib.get::<TargetFeaturesFn>(b"railmbs_target_features\0") } {
+            // SAFETY: a NUL-terminated static string of the plugin.
+            let list = c_str(unsafe { features() });
+            let missing = missing_target_features(&list);
+            target_features = Some(
+                list.split(',')
+                    .filter(|f| !f.is_empty())
+                    .map(str::to_owned)
+                    .collect(),
+            );
+            if !missing.is_empty() {
+                return Err(PluginError::CpuFeatures {
+                    path: path.to_path_buf(),
+                    missing,
+                });
+            }
+        }
         // SAFETY: the signatures are those of the ABI; checked by version below
         // before `evaluate` is ever called.
         let info_fn: InfoFn = unsafe { lib.get::<InfoFn>(b"railmbs_plugin_info\0") }
@@ -187,6 +298,9 @@ impl Plugin {
                 expected: ABI_VERSION,
             });
         }
+        let Some(target_features) = target_features else {
+            return Err(missing("railmbs_target_features"));
+        };
         let fixed = (0..info.fixed_count as usize)
             .map(|k| {
                 // SAFETY: arrays of `fixed_count` entries exported by the plugin.
@@ -201,6 +315,7 @@ impl Plugin {
         Ok(Self {
             path: path.to_path_buf(),
             evaluate,
+            target_features,
             dof: info.dof as usize,
             bodies: info.bodies as usize,
             constraints: info.constraints as usize,

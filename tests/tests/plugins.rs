@@ -79,6 +79,87 @@ fn a_file_that_is_not_a_plugin_is_refused() {
 }
 
 #[test]
+fn a_plugin_for_cpu_features_this_machine_lacks_is_refused() {
+    // A library that reports a feature no CPU has: refused before any other of its
+    // functions runs, naming the feature and the way out.
+    let model = mechanism("pendulum");
+    let lib = railmbs_build_support::build_plugin(
+        "#[no_mangle] pub extern \"C\" fn railmbs_target_features() -> *const u8 { \
+         b\"avx,no-such-feature\\0\".as_ptr() }",
+        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(cache()),
+    )
+    .unwrap();
+    let err = Plugin::load_for(&lib.path, &model).unwrap_err();
+    match &err {
+        PluginError::CpuFeatures { missing, .. } => {
+            assert!(missing.contains(&"no-such-feature".to_owned()), "{err}")
+        }
+        other => panic!("expected CpuFeatures, got {other}"),
+    }
+    let msg = err.to_string();
+    assert!(
+        msg.contains("no-such-feature") && msg.contains("--portable"),
+        "{msg}"
+    );
+    // Every feature a generated plugin may report can be checked on this machine.
+    if cfg!(target_arch = "x86_64") {
+        for f in railmbs_codegen::emit::REPORTED_TARGET_FEATURES {
+            assert!(
+                railmbs_runtime::plugin::host_has_target_feature(f).is_some(),
+                "the loader cannot check {f}"
+            );
+        }
+    }
+}
+
+#[test]
+fn native_and_portable_plugins_report_their_cpu_features_and_agree() {
+    // The default plugin is built for this CPU and loads here; the portable one reports
+    // only the baseline (no AVX); both give the same mass matrix to rounding.
+    let model = mechanism("double_pendulum");
+    let abi = railmbs_runtime::plugin::ABI_VERSION;
+    let native = build(&model, abi);
+    let mut opts = railmbs_codegen::GenerateOptions::new(abi);
+    opts.portable = true;
+    let portable = railmbs_codegen::build_plugin(&model, &opts, Some(cache()))
+        .unwrap()
+        .path;
+    assert_ne!(native, portable);
+    let features = |path: &std::path::Path| Plugin::open(path).unwrap().target_features.clone();
+    let (fn_native, fn_portable) = (features(&native), features(&portable));
+    if cfg!(target_arch = "x86_64") {
+        assert!(
+            !fn_portable.iter().any(|f| f.starts_with("avx")),
+            "{fn_portable:?}"
+        );
+        if railmbs_runtime::plugin::host_has_target_feature("avx2") == Some(true) {
+            assert!(fn_native.contains(&"avx2".to_owned()), "{fn_native:?}");
+        }
+    }
+    use railmbs_runtime::Equations;
+    let params = model.default_parameter_values();
+    let (q, v) = model.initial_state(&params);
+    let mut masses = Vec::new();
+    for path in [&native, &portable] {
+        let mut eq = railmbs_runtime::PluginEquations::new(Plugin::load_for(path, &model).unwrap());
+        eq.set_parameters(&params).unwrap();
+        let mut out = railmbs_runtime::Evaluation::for_equations(&eq);
+        eq.evaluate(
+            0.0,
+            q.as_slice(),
+            v.as_slice(),
+            railmbs_runtime::Parts::ALL,
+            &mut out,
+        )
+        .unwrap();
+        masses.push(out.mass);
+    }
+    for (a, b) in masses[0].iter().zip(masses[1].iter()) {
+        assert!((a - b).abs() <= 1e-14 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+}
+
+#[test]
 fn fixed_parameters_are_folded_and_other_values_refused() {
     let model = mechanism("pendulum");
     let mut opts = railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
