@@ -55,11 +55,13 @@ impl GenerateOptions {
 /// where plugins report their CPU features to the loader (`railmbs_target_features`); none
 /// elsewhere.
 ///
-/// Measured with `umsim bench` (M, k and Q_g per evaluation, AMD EPYC with AVX-512, rustc
-/// 1.95): Vehicle 1 (42 dof) 554 → 3xx ns, chain30 1231 → 9xx ns. The numeric engine, built
-/// by cargo, gains nothing from the same flag (chain30 2430 vs 2438 ns, Vehicle 1 1512 vs
-/// 1515 ns with `RUSTFLAGS="-C target-cpu=native"`): straight-line code uses the 32 vector
-/// registers and the wider batch of sin and cos, a recursion over joints does not.
+/// Measured with `umsim bench [--portable]` (M, k and Q_g per evaluation, AMD EPYC with
+/// AVX-512, rustc 1.95, portable → native in one run each): Vehicle 1 (42 dof) 518 → 319 ns,
+/// chain30 1407 → 977 ns, chain10 181 → 147 ns. The numeric engine, built by cargo, gains
+/// nothing from the same flag (chain30 2430 vs 2438 ns, Vehicle 1 1512 vs 1515 ns with
+/// `RUSTFLAGS="-C target-cpu=native"`): the straight-line code uses the 32 vector registers,
+/// the three-operand instructions and the 8-wide batch of sin and cos; the numeric engine's
+/// recursion over joints does not.
 pub fn native_cpu_flags() -> Vec<String> {
     if cfg!(target_arch = "x86_64") {
         vec!["-C".to_owned(), "target-cpu=native".to_owned()]
