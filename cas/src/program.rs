@@ -260,12 +260,31 @@ impl Builder {
         }
     }
 
-    /// `constant + Σ c·t`. Terms with the same |c| ≠ 1 are grouped and multiplied once:
-    /// `c·a + c·b − c·d = c·(a + b − d)`. Negation is folded into subtractions: positive items
-    /// are added first, then the constant, then negative items subtracted. With no positive
-    /// part, an item with |c| ≠ 1 takes the sign into its multiplication; only a sum of
-    /// unit-negative terms needs an explicit negation. `pre` are already lowered partial sums
-    /// (negated when the flag is set) added before the terms.
+    /// Sum of `vals` as a balanced tree of additions (pairs of neighbours, then pairs of
+    /// pairs, …): the same number of additions as a chain, but a dependency depth of
+    /// ⌈log₂ n⌉ instead of n − 1, so that the processor overlaps them.
+    fn sum_tree(&mut self, vals: &[Operand]) -> Option<Operand> {
+        let mut level: Vec<Operand> = vals.to_vec();
+        while level.len() > 1 {
+            level = level
+                .chunks(2)
+                .map(|p| match *p {
+                    [a, b] => self.emit(Instr::Add(a, b)),
+                    [a] => a,
+                    _ => unreachable!("chunks of two"),
+                })
+                .collect();
+        }
+        level.first().copied()
+    }
+
+    /// `constant + Σ c·t + Σ ±pre`. Terms with the same |c| ≠ 1 are grouped and multiplied once:
+    /// `c·a + c·b − c·d = c·(a + b − d)`. Positive and negative parts are summed as balanced
+    /// trees and subtracted once; `pre` (already lowered partial sums, negated when the flag is
+    /// set: the recursion M_ij = M_(i+1)j + … that sum reuse recovers) are added last, so that
+    /// a chain of such sums costs one dependent operation per link. With no positive part, an
+    /// item with |c| ≠ 1 takes the sign into its multiplication; only a sum of unit-negative
+    /// terms needs an explicit negation.
     fn lower_sum(
         &mut self,
         constant: f64,
@@ -274,8 +293,7 @@ impl Builder {
         op: impl Fn(ExprId) -> Operand,
     ) -> Operand {
         // Items: (operand, |coefficient|, negative?), groups in order of first appearance.
-        let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len() + pre.len());
-        items.extend(pre.iter().map(|&(o, neg)| (o, 1.0, neg)));
+        let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len());
         let mut groups: Vec<(f64, Vec<Operand>, Vec<Operand>)> = Vec::new();
         let mut group_of: FxMap<u64, usize> = FxMap::default();
         for &(b, c) in terms {
@@ -295,24 +313,13 @@ impl Builder {
             }
         }
         for (m, pos, neg) in groups {
-            let inner = match pos.split_first() {
-                Some((&first, rest)) => {
-                    let mut a = first;
-                    for &t in rest {
-                        a = self.emit(Instr::Add(a, t));
-                    }
-                    for &t in &neg {
-                        a = self.emit(Instr::Sub(a, t));
-                    }
-                    (a, false)
-                }
-                None => {
-                    let mut a = neg[0];
-                    for &t in &neg[1..] {
-                        a = self.emit(Instr::Add(a, t));
-                    }
-                    (a, true)
-                }
+            let p = self.sum_tree(&pos);
+            let n = self.sum_tree(&neg);
+            let inner = match (p, n) {
+                (Some(p), Some(n)) => (self.emit(Instr::Sub(p, n)), false),
+                (Some(p), None) => (p, false),
+                (None, Some(n)) => (n, true),
+                (None, None) => unreachable!("a group has a term"),
             };
             items.push((inner.0, m, inner.1));
         }
@@ -323,48 +330,58 @@ impl Builder {
                 s.emit(Instr::Mul(Operand::Const(m), t))
             }
         };
-        let mut acc: Option<Operand> = None;
-        for &(t, m, _) in items.iter().filter(|i| !i.2) {
-            let v = scaled(self, t, m);
-            acc = Some(match acc {
-                None => v,
-                Some(a) => self.emit(Instr::Add(a, v)),
-            });
-        }
-        if constant != 0.0 {
-            acc = Some(match acc {
-                None => Operand::Const(constant),
-                Some(a) if constant > 0.0 => self.emit(Instr::Add(a, Operand::Const(constant))),
-                Some(a) => self.emit(Instr::Sub(a, Operand::Const(-constant))),
-            });
-        }
-        let negs: Vec<(Operand, f64)> = items
-            .iter()
-            .filter(|i| i.2)
-            .map(|&(t, m, _)| (t, m))
-            .collect();
-        let mut skip = usize::MAX;
-        if acc.is_none() {
-            // Only negative items, no constant.
-            if let Some(i) = negs.iter().position(|t| t.1 != 1.0) {
-                acc = Some(scaled(self, negs[i].0, -negs[i].1));
-                skip = i;
-            } else if negs.len() == 1 {
-                return self.emit(Instr::Neg(negs[0].0));
+        let pre_pos: Vec<Operand> = pre.iter().filter(|p| !p.1).map(|p| p.0).collect();
+        let pre_neg: Vec<Operand> = pre.iter().filter(|p| p.1).map(|p| p.0).collect();
+        let mut pos: Vec<Operand> = Vec::new();
+        let mut neg: Vec<Operand> = Vec::new();
+        let nothing_positive = constant <= 0.0 && pre_pos.is_empty() && items.iter().all(|i| i.2);
+        // With nothing positive, a scaled negative item starts the sum as (−m)·t.
+        let signed_start = if nothing_positive {
+            items.iter().position(|i| i.1 != 1.0)
+        } else {
+            None
+        };
+        for (i, &(t, m, negative)) in items.iter().enumerate() {
+            if Some(i) == signed_start {
+                pos.push(scaled(self, t, -m));
+            } else if negative {
+                neg.push(scaled(self, t, m));
             } else {
-                let mut a = negs[0].0;
-                for &(t, _) in &negs[1..] {
-                    a = self.emit(Instr::Add(a, t));
-                }
-                return self.emit(Instr::Neg(a));
+                pos.push(scaled(self, t, m));
             }
         }
-        let mut a = acc.unwrap_or(Operand::Const(0.0));
-        for (i, &(t, m)) in negs.iter().enumerate() {
-            if i != skip {
-                let v = scaled(self, t, m);
-                a = self.emit(Instr::Sub(a, v));
-            }
+        if constant > 0.0 {
+            pos.push(Operand::Const(constant));
+        } else if constant < 0.0 {
+            neg.push(Operand::Const(-constant));
+        }
+        if pos.is_empty() && pre_pos.is_empty() {
+            // Only unit-negative items (and negative partial sums or constant).
+            neg.extend(pre_neg);
+            let n = self.sum_tree(&neg).unwrap_or(Operand::Const(0.0));
+            return self.emit(Instr::Neg(n));
+        }
+        let p = self.sum_tree(&pos);
+        let n = self.sum_tree(&neg);
+        let mut acc = match (p, n) {
+            (Some(p), Some(n)) => Some(self.emit(Instr::Sub(p, n))),
+            (Some(p), None) => Some(p),
+            (None, _) => None,
+        };
+        for &t in &pre_pos {
+            acc = Some(match acc {
+                None => t,
+                Some(a) => self.emit(Instr::Add(a, t)),
+            });
+        }
+        let mut a = acc.expect("a positive part");
+        if p.is_none()
+            && let Some(n) = n
+        {
+            a = self.emit(Instr::Sub(a, n));
+        }
+        for &t in &pre_neg {
+            a = self.emit(Instr::Sub(a, t));
         }
         a
     }
@@ -761,19 +778,39 @@ impl SumIndex {
         index
     }
 
-    /// Other sums whose terms are all among `terms` (disjoint from each other), largest first,
-    /// each with `true` when it enters negated; and the terms and constant left over.
+    /// Operations to lower `terms + constant` directly: the additions, plus one
+    /// multiplication per distinct coefficient magnitude other than 1 (`Builder::lower_sum`).
+    fn direct_cost(terms: &[(ExprId, f64)], constant: f64) -> usize {
+        let mut scales: Vec<u64> = terms
+            .iter()
+            .map(|t| t.1.abs())
+            .filter(|&m| m != 1.0)
+            .map(f64::to_bits)
+            .collect();
+        scales.sort_unstable();
+        scales.dedup();
+        terms.len().saturating_sub(1) + usize::from(constant != 0.0) + scales.len()
+    }
+
+    /// Splits the sum `id` = `constant + terms` into other sums of the program and a rest:
+    /// `S = ±T₁ ± T₂ … + D`. A partial sum T qualifies when each of its terms is a term of
+    /// what is left of S (coefficients may differ: the rest keeps the difference), and is
+    /// taken when that makes the sum cheaper to lower ([`Self::direct_cost`]). With equal
+    /// coefficients this recovers recursions like M_ij = M_(i+1)j + …; with differing ones,
+    /// sums of sums such as a composite force F_i = F_(i+1) + m·a_i, whose flattened terms
+    /// carry a coefficient that grows with the number of bodies beyond i.
+    ///
+    /// The recursion ends: a partial sum has fewer terms than S, or as many and a smaller node
+    /// id, so no two sums take each other.
     fn parts(&mut self, id: ExprId, constant: f64, terms: &[(ExprId, f64)]) -> SumParts {
         let mut rest: Vec<(ExprId, f64)> = terms.to_vec();
+        rest.sort_unstable_by_key(|&(b, _)| b);
         let mut rest_constant = constant;
         let mut parts = Vec::new();
         let Some(&me) = self.of_node.get(&id) else {
             return (parts, rest, rest_constant);
         };
         while parts.len() < Self::MAX_PARTS && rest.len() >= 2 {
-            // `rest` by term, for the subset checks.
-            let mut sorted = rest.clone();
-            sorted.sort_unstable_by_key(|&(b, _)| b);
             // Candidates: the sums containing one of the rarest terms (short lists). A large
             // partial sum contains most terms, so it is among them unless it misses all the
             // probed ones; checking every sum that shares any term would cost O(n⁴) on a
@@ -782,7 +819,10 @@ impl SumIndex {
             probes.sort_unstable_by_key(|b| (self.by_term.get(b).map_or(0, Vec::len), *b));
             probes.truncate(Self::PROBES);
             self.generation += 1;
-            let mut best: Option<(usize, ExprId, bool, f64)> = None;
+            let mut best_cost = Self::direct_cost(&rest, rest_constant);
+            // (sum number, negated)
+            let mut best: Option<(u32, bool)> = None;
+            let mut at: Vec<usize> = Vec::new();
             for base in &probes {
                 for &(k, _) in self.by_term.get(base).map_or(&[][..], |v| v) {
                     if k == me || self.seen[k as usize] == self.generation {
@@ -791,38 +831,47 @@ impl SumIndex {
                     self.seen[k as usize] = self.generation;
                     let (node, kc, ref t_terms) = self.sums[k as usize];
                     let len = t_terms.len();
-                    let better = best.is_none_or(|b| {
-                        (len, std::cmp::Reverse(node)) > (b.0, std::cmp::Reverse(b.1))
+                    if len > rest.len() || !(len < terms.len() || (len == terms.len() && node < id))
+                    {
+                        continue;
+                    }
+                    at.clear();
+                    let contained = t_terms.iter().all(|&(b, _)| {
+                        rest.binary_search_by_key(&b, |t| t.0)
+                            .map(|i| at.push(i))
+                            .is_ok()
                     });
-                    if len > rest.len() || !better {
+                    if !contained {
                         continue;
                     }
-                    let sign =
-                        |&(b, c): &(ExprId, f64)| match sorted.binary_search_by_key(&b, |t| t.0) {
-                            Ok(i) if sorted[i].1 == c => 1,
-                            Ok(i) if sorted[i].1 == -c => -1,
-                            _ => 0,
-                        };
-                    let first = sign(&t_terms[0]);
-                    if first == 0 || !t_terms[1..].iter().all(|t| sign(t) == first) {
-                        continue;
-                    }
-                    let negated = first < 0;
-                    let kc = if negated { -kc } else { kc };
-                    // The same terms again only as the constant-free sum, so that two sums
-                    // never refer to each other (T = −S).
-                    let smaller = len < terms.len() || (!negated && kc == 0.0 && constant != 0.0);
-                    if smaller && (kc == 0.0 || kc == rest_constant) {
-                        best = Some((len, node, negated, kc));
+                    for negated in [false, true] {
+                        let sign = if negated { -1.0 } else { 1.0 };
+                        let mut left = rest.clone();
+                        for (&i, &(_, c)) in at.iter().zip(t_terms.iter()) {
+                            left[i].1 -= sign * c;
+                        }
+                        left.retain(|t| t.1 != 0.0);
+                        let cost = 1 + Self::direct_cost(&left, rest_constant - sign * kc);
+                        if cost < best_cost {
+                            best_cost = cost;
+                            best = Some((k, negated));
+                        }
                     }
                 }
             }
-            let Some((_, node, negated, kc)) = best else {
+            let Some((k, negated)) = best else {
                 break;
             };
-            let (_, _, ref t_terms) = self.sums[self.of_node[&node] as usize];
-            rest.retain(|(base, _)| t_terms.binary_search_by_key(base, |t| t.0).is_err());
-            rest_constant -= kc;
+            let (node, kc, ref t_terms) = self.sums[k as usize];
+            let sign = if negated { -1.0 } else { 1.0 };
+            for &(b, c) in t_terms.iter() {
+                let i = rest
+                    .binary_search_by_key(&b, |t| t.0)
+                    .expect("a partial sum's terms are in the rest");
+                rest[i].1 -= sign * c;
+            }
+            rest.retain(|t| t.1 != 0.0);
+            rest_constant -= sign * kc;
             parts.push((node, negated));
         }
         (parts, rest, rest_constant)

@@ -743,3 +743,43 @@ fn sums_reuse_the_sums_they_contain() {
     };
     assert_eq!(prog.eval(&vals).unwrap(), c.eval(&outputs, &vals).unwrap());
 }
+
+#[test]
+fn sums_of_sums_reuse_their_differences() {
+    // a_k = x_0 + … + x_k (the velocity-product acceleration of link k of a chain) and
+    // F_i = a_i + … + a_(n−1) (the force on the links beyond joint i). Flattened, F_i is
+    // Σ_m (n − max(i, m))·x_m: its coefficients change with i, so no F_(i+1) is a subset of
+    // F_i with equal coefficients. F_i − F_(i+1) = a_i is, though: one addition per sum,
+    // where lowering each F_i by itself takes O(n) operations (O(n²) in all).
+    let n: usize = 10;
+    let mut c = Context::new();
+    let x: Vec<ExprId> = (0..n).map(|i| c.q(i as u32)).collect();
+    let a: Vec<ExprId> = (0..n).map(|k| c.add_many(&x[..=k])).collect();
+    let f: Vec<ExprId> = (0..n).map(|i| c.add_many(&a[i..])).collect();
+    let mut outputs = f.clone();
+    outputs.extend(&a);
+    let prog = Program::compile(&c, &outputs);
+    let total = prog.op_counts().total();
+    // Linear: n − 1 additions for the a_k and about one per F_i (the first F lowered may
+    // keep a few scaled terms: at most four partial sums are taken into one sum).
+    assert!(total <= 3 * n as u128, "{total} operations:\n{prog}");
+    // Each F_i lowered alone: n − 1 additions and a multiplication per distinct coefficient.
+    let separately: u128 = f
+        .iter()
+        .map(|&fi| Program::compile(&c, &[fi]).op_counts().total())
+        .sum();
+    assert!(separately > 5 * total, "{separately} vs {total}");
+    let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.7 * i as f64).collect();
+    let vals = Values {
+        q: &q,
+        ..Default::default()
+    };
+    for (g, w) in prog
+        .eval(&vals)
+        .unwrap()
+        .iter()
+        .zip(c.eval(&outputs, &vals).unwrap())
+    {
+        assert!((g - w).abs() <= 1e-13 * w.abs(), "{g} vs {w}");
+    }
+}
