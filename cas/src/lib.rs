@@ -126,6 +126,7 @@
 mod calculus;
 mod eval;
 mod graph;
+mod lanes;
 mod linalg;
 mod program;
 
@@ -134,5 +135,6 @@ pub use eval::{CasError, Values};
 pub use graph::{
     Context, Display, ExprId, FLATTEN_LIMIT, Func, Node, ONE, Symbol, SymbolKind, ZERO,
 };
+pub use lanes::Packed;
 pub use linalg::{IDENTITY, Mat3, Vec3};
 pub use program::{Chunk, Instr, OpCounts, Operand, Program, SplitProgram};

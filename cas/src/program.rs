@@ -167,6 +167,8 @@ enum InstrKey {
 /// integer powers are emitted once.
 struct Builder {
     instrs: Vec<Instr>,
+    /// Per instruction: the length of the longest chain of instructions ending in it.
+    depth: Vec<u32>,
     share: bool,
     vn: FxMap<InstrKey, u32>,
     pows: FxMap<(ExprId, u32), Operand>,
@@ -176,6 +178,7 @@ impl Builder {
     fn new(share: bool, capacity: usize) -> Self {
         Builder {
             instrs: Vec::with_capacity(capacity),
+            depth: Vec::with_capacity(capacity),
             share,
             vn: FxMap::with_capacity_and_hasher(if share { capacity } else { 0 }, FxBuild),
             pows: FxMap::default(),
@@ -204,8 +207,20 @@ impl Builder {
             }
             self.vn.insert(ik, k);
         }
+        let mut d = 0;
+        i.for_each_operand(|o| d = d.max(self.depth_of(o)));
+        self.depth.push(d + 1);
         self.instrs.push(i);
         Operand::Tmp(k)
+    }
+
+    /// Chain length ending in `o` (0 for inputs, constants and temporaries this builder did
+    /// not emit, such as the placeholders of [`Context::tree_op_counts`]).
+    fn depth_of(&self, o: Operand) -> u32 {
+        match o {
+            Operand::Tmp(k) => self.depth.get(k as usize).copied().unwrap_or(0),
+            _ => 0,
+        }
     }
 
     /// `t^n` (n ≥ 1) by binary powering: n even → (t^(n/2))², n odd → t^(n−1)·t.
@@ -260,31 +275,40 @@ impl Builder {
         }
     }
 
-    /// Sum of `vals` as a balanced tree of additions (pairs of neighbours, then pairs of
-    /// pairs, …): the same number of additions as a chain, but a dependency depth of
-    /// ⌈log₂ n⌉ instead of n − 1, so that the processor overlaps them.
-    fn sum_tree(&mut self, vals: &[Operand]) -> Option<Operand> {
-        let mut level: Vec<Operand> = vals.to_vec();
-        while level.len() > 1 {
-            level = level
-                .chunks(2)
-                .map(|p| match *p {
-                    [a, b] => self.emit(Instr::Add(a, b)),
-                    [a] => a,
-                    _ => unreachable!("chunks of two"),
-                })
-                .collect();
+    /// `Σ ±v` over signed items, combining the two shallowest items first (Huffman's rule on
+    /// the chain lengths): the same number of operations as a chain, the shortest dependency
+    /// chain for the result, and a deep item such as the previous link of a recursion
+    /// (M_ij = M_(i+1)j + …) enters last, with one operation. Two items of one sign add; of
+    /// opposite signs, the negative is subtracted. `None` for no items; the flag is `true`
+    /// when the result enters negated (all items were negative).
+    fn signed_sum(&mut self, items: &[(Operand, bool)]) -> Option<(Operand, bool)> {
+        use std::cmp::Reverse;
+        let mut heap: std::collections::BinaryHeap<Reverse<(u32, usize)>> = Default::default();
+        let mut slots: Vec<(Operand, bool)> = items.to_vec();
+        for (i, &(o, _)) in items.iter().enumerate() {
+            heap.push(Reverse((self.depth_of(o), i)));
         }
-        level.first().copied()
+        while heap.len() > 1 {
+            let Reverse((_, i)) = heap.pop().expect("two items");
+            let Reverse((_, j)) = heap.pop().expect("two items");
+            let ((a, na), (b, nb)) = (slots[i], slots[j]);
+            let combined = match (na, nb) {
+                (false, false) => (self.emit(Instr::Add(a, b)), false),
+                (true, true) => (self.emit(Instr::Add(a, b)), true),
+                (false, true) => (self.emit(Instr::Sub(a, b)), false),
+                (true, false) => (self.emit(Instr::Sub(b, a)), false),
+            };
+            slots.push(combined);
+            heap.push(Reverse((self.depth_of(combined.0), slots.len() - 1)));
+        }
+        heap.pop().map(|Reverse((_, i))| slots[i])
     }
 
     /// `constant + Σ c·t + Σ ±pre`. Terms with the same |c| ≠ 1 are grouped and multiplied once:
-    /// `c·a + c·b − c·d = c·(a + b − d)`. Positive and negative parts are summed as balanced
-    /// trees and subtracted once; `pre` (already lowered partial sums, negated when the flag is
-    /// set: the recursion M_ij = M_(i+1)j + … that sum reuse recovers) are added last, so that
-    /// a chain of such sums costs one dependent operation per link. With no positive part, an
-    /// item with |c| ≠ 1 takes the sign into its multiplication; only a sum of unit-negative
-    /// terms needs an explicit negation.
+    /// `c·a + c·b − c·d = c·(a + b − d)`. All items (scaled terms, the constant, `pre`: already
+    /// lowered partial sums, negated when the flag is set) are combined by
+    /// [`Builder::signed_sum`]. With no positive part, an item with |c| ≠ 1 takes the sign into
+    /// its multiplication; only a sum of unit-negative items needs an explicit negation.
     fn lower_sum(
         &mut self,
         constant: f64,
@@ -294,7 +318,7 @@ impl Builder {
     ) -> Operand {
         // Items: (operand, |coefficient|, negative?), groups in order of first appearance.
         let mut items: Vec<(Operand, f64, bool)> = Vec::with_capacity(terms.len());
-        let mut groups: Vec<(f64, Vec<Operand>, Vec<Operand>)> = Vec::new();
+        let mut groups: Vec<(f64, Vec<(Operand, bool)>)> = Vec::new();
         let mut group_of: FxMap<u64, usize> = FxMap::default();
         for &(b, c) in terms {
             let m = c.abs();
@@ -303,25 +327,14 @@ impl Builder {
                 continue;
             }
             let g = *group_of.entry(m.to_bits()).or_insert_with(|| {
-                groups.push((m, Vec::new(), Vec::new()));
+                groups.push((m, Vec::new()));
                 groups.len() - 1
             });
-            if c > 0.0 {
-                groups[g].1.push(op(b));
-            } else {
-                groups[g].2.push(op(b));
-            }
+            groups[g].1.push((op(b), c < 0.0));
         }
-        for (m, pos, neg) in groups {
-            let p = self.sum_tree(&pos);
-            let n = self.sum_tree(&neg);
-            let inner = match (p, n) {
-                (Some(p), Some(n)) => (self.emit(Instr::Sub(p, n)), false),
-                (Some(p), None) => (p, false),
-                (None, Some(n)) => (n, true),
-                (None, None) => unreachable!("a group has a term"),
-            };
-            items.push((inner.0, m, inner.1));
+        for (m, members) in groups {
+            let (inner, negated) = self.signed_sum(&members).expect("a group has a term");
+            items.push((inner, m, negated));
         }
         let scaled = |s: &mut Self, t: Operand, m: f64| {
             if m == 1.0 {
@@ -330,60 +343,31 @@ impl Builder {
                 s.emit(Instr::Mul(Operand::Const(m), t))
             }
         };
-        let pre_pos: Vec<Operand> = pre.iter().filter(|p| !p.1).map(|p| p.0).collect();
-        let pre_neg: Vec<Operand> = pre.iter().filter(|p| p.1).map(|p| p.0).collect();
-        let mut pos: Vec<Operand> = Vec::new();
-        let mut neg: Vec<Operand> = Vec::new();
-        let nothing_positive = constant <= 0.0 && pre_pos.is_empty() && items.iter().all(|i| i.2);
+        let nothing_positive =
+            constant <= 0.0 && pre.iter().all(|p| p.1) && items.iter().all(|i| i.2);
         // With nothing positive, a scaled negative item starts the sum as (−m)·t.
         let signed_start = if nothing_positive {
             items.iter().position(|i| i.1 != 1.0)
         } else {
             None
         };
+        let mut all: Vec<(Operand, bool)> = Vec::with_capacity(items.len() + pre.len() + 1);
         for (i, &(t, m, negative)) in items.iter().enumerate() {
             if Some(i) == signed_start {
-                pos.push(scaled(self, t, -m));
-            } else if negative {
-                neg.push(scaled(self, t, m));
+                all.push((scaled(self, t, -m), false));
             } else {
-                pos.push(scaled(self, t, m));
+                all.push((scaled(self, t, m), negative));
             }
         }
-        if constant > 0.0 {
-            pos.push(Operand::Const(constant));
-        } else if constant < 0.0 {
-            neg.push(Operand::Const(-constant));
+        if constant != 0.0 {
+            all.push((Operand::Const(constant.abs()), constant < 0.0));
         }
-        if pos.is_empty() && pre_pos.is_empty() {
-            // Only unit-negative items (and negative partial sums or constant).
-            neg.extend(pre_neg);
-            let n = self.sum_tree(&neg).unwrap_or(Operand::Const(0.0));
-            return self.emit(Instr::Neg(n));
+        all.extend_from_slice(pre);
+        match self.signed_sum(&all) {
+            None => Operand::Const(0.0),
+            Some((v, false)) => v,
+            Some((v, true)) => self.emit(Instr::Neg(v)),
         }
-        let p = self.sum_tree(&pos);
-        let n = self.sum_tree(&neg);
-        let mut acc = match (p, n) {
-            (Some(p), Some(n)) => Some(self.emit(Instr::Sub(p, n))),
-            (Some(p), None) => Some(p),
-            (None, _) => None,
-        };
-        for &t in &pre_pos {
-            acc = Some(match acc {
-                None => t,
-                Some(a) => self.emit(Instr::Add(a, t)),
-            });
-        }
-        let mut a = acc.expect("a positive part");
-        if p.is_none()
-            && let Some(n) = n
-        {
-            a = self.emit(Instr::Sub(a, n));
-        }
-        for &t in &pre_neg {
-            a = self.emit(Instr::Sub(a, t));
-        }
-        a
     }
 }
 
@@ -617,16 +601,17 @@ impl Program {
     /// defining chunk stores them into a slot, later chunks load them from it. Slots are reused
     /// once a temporary is dead (greedy allocation in chunk order).
     pub fn split(&self, max_instrs: usize) -> Result<SplitProgram, CasError> {
-        self.split_keeping(max_instrs, 0..0)
+        self.split_keeping(max_instrs, &[])
     }
 
-    /// [`Program::split`], but the instructions of `together` (such as the range of
-    /// [`Program::batch_sin_cos`]) end up in one chunk: a chunk that would end inside it ends
-    /// before it instead, or, if it starts there, grows to its end.
+    /// [`Program::split`], but the instructions of each range of `together` (sorted and
+    /// disjoint, such as the batch of [`Program::batch_sin_cos`] and the packs of
+    /// [`Program::pack_lanes`]) end up in one chunk: a chunk that would end inside a range
+    /// ends before it instead, or, if the range starts the chunk, grows to its end.
     pub fn split_keeping(
         &self,
         max_instrs: usize,
-        together: Range<usize>,
+        together: &[Range<usize>],
     ) -> Result<SplitProgram, CasError> {
         if max_instrs == 0 {
             return Err(CasError::InvalidArgument(
@@ -638,12 +623,12 @@ impl Program {
         let mut start = 0;
         while start < n {
             let mut end = (start + max_instrs).min(n);
-            if together.start < end && end < together.end {
-                end = if together.start > start {
-                    together.start
-                } else {
-                    together.end
-                };
+            // The last range starting before the cut, if the cut falls inside it.
+            let i = together.partition_point(|r| r.start < end);
+            if let Some(r) = i.checked_sub(1).map(|i| &together[i])
+                && end < r.end
+            {
+                end = if r.start > start { r.start } else { r.end };
             }
             bounds.push(start..end);
             start = end;
@@ -1058,6 +1043,7 @@ impl Context {
         for id in order {
             let node = self.node(id);
             b.instrs.clear();
+            b.depth.clear();
             b.lower(node, |_| Operand::Tmp(0));
             let mut c = b
                 .instrs

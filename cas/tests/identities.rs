@@ -783,3 +783,57 @@ fn sums_of_sums_reuse_their_differences() {
         assert!((g - w).abs() <= 1e-13 * w.abs(), "{g} vs {w}");
     }
 }
+
+#[test]
+fn column_recursions_pack_into_lanes() {
+    // Four columns c of M_i,c = M_(i+1),c + s_i·x_c + k_i·y_c (s_i, k_i shared by the
+    // columns, x_c and y_c each column's own: the shape of a chain's mass matrix), asked for
+    // row by row. The rows of the four columns grow into one tree of packs, four per row
+    // (two products, their sum, the recursion's addition); values stay bit-identical.
+    let (rows, w) = (6usize, 4usize);
+    let mut c = Context::new();
+    let s: Vec<ExprId> = (0..rows).map(|i| c.q(i as u32)).collect();
+    let k: Vec<ExprId> = (0..rows).map(|i| c.v(i as u32)).collect();
+    let x: Vec<ExprId> = (0..w).map(|l| c.p(l as u32)).collect();
+    let y: Vec<ExprId> = (0..w).map(|l| c.p((w + l) as u32)).collect();
+    let mut entries = vec![vec![ZERO; w]; rows + 1];
+    for l in 0..w {
+        entries[rows][l] = c.p((2 * w + l) as u32); // the diagonal
+        for i in (0..rows).rev() {
+            let a = c.mul(s[i], x[l]);
+            let b = c.mul(k[i], y[l]);
+            entries[i][l] = c.add_many(&[entries[i + 1][l], a, b]);
+        }
+    }
+    let outputs: Vec<ExprId> = (0..rows).flat_map(|i| entries[i].clone()).collect();
+    let prog = Program::compile(&c, &outputs);
+    let seeds: Vec<Vec<u32>> = (0..rows)
+        .map(|i| {
+            (0..w)
+                .map(|l| match prog.outputs[i * w + l] {
+                    Operand::Tmp(t) => t,
+                    other => panic!("entry ({i}, {l}) is {other}"),
+                })
+                .collect()
+        })
+        .collect();
+    let packed = prog.pack_lanes(&seeds, w, &[]);
+    assert_eq!(packed.packs.len(), 4 * rows, "{}", packed.program);
+    let q: Vec<f64> = (0..rows).map(|i| 0.3 + 0.1 * i as f64).collect();
+    let v: Vec<f64> = (0..rows).map(|i| -0.7 + 0.2 * i as f64).collect();
+    let p: Vec<f64> = (0..3 * w).map(|i| 1.0 + 0.37 * i as f64).collect();
+    let vals = Values {
+        q: &q,
+        v: &v,
+        p: &p,
+        ..Default::default()
+    };
+    assert_eq!(
+        packed.program.eval(&vals).unwrap(),
+        prog.eval(&vals).unwrap()
+    );
+    // Too few lanes to pay, or a seed of lanes that depend on each other: nothing packed.
+    assert!(prog.pack_lanes(&seeds, 1, &[]).packs.is_empty());
+    let chain: Vec<u32> = seeds.iter().map(|s| s[0]).take(w).collect();
+    assert!(prog.pack_lanes(&[chain], w, &[]).packs.is_empty());
+}
