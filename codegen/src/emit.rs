@@ -36,6 +36,10 @@ pub(crate) struct Unit {
     /// Instructions of `program` computed by one `sin_cos_batch` call
     /// ([`Program::batch_sin_cos`]).
     pub trig_batch: std::ops::Range<usize>,
+    /// Lanes of the vector operations ([`Program::pack_lanes`]); 1 for none.
+    pub lanes: usize,
+    /// First instructions of the packs (each `lanes` instructions computed as one vector).
+    pub packs: Vec<usize>,
 }
 
 impl Unit {
@@ -44,15 +48,54 @@ impl Unit {
         ctx: &railmbs_cas::Context,
         outputs: &[railmbs_cas::ExprId],
         targets: Vec<Target>,
+        n: usize,
+        lanes: usize,
     ) -> Unit {
         let (program, trig_batch) = Program::compile(ctx, outputs).batch_sin_cos();
+        let seeds = mass_row_seeds(&program, &targets, n, lanes);
+        let packed = program.pack_lanes(&seeds, lanes, std::slice::from_ref(&trig_batch));
         Unit {
             name,
-            program,
+            program: packed.program,
             targets,
-            trig_batch,
+            trig_batch: packed.keep[0].clone(),
+            lanes: packed.width,
+            packs: packed.packs,
         }
     }
+}
+
+/// Seeds for [`Program::pack_lanes`]: the upper-triangle mass entries M(r, c … c+lanes−1) of
+/// one row and a block of adjacent columns, whose mirrored entries M(c … c+lanes−1, r) are
+/// adjacent in the column-major buffer. Rows go from the first, where the column recursions
+/// M_rc = M_(r+1)c + … end, so that one seed grows down a whole block of columns. Blocks are
+/// tried at every alignment, the one ending at the last column first (the longest columns
+/// fill whole blocks): a column whose entries are lowered differently (a chain's last link,
+/// whose composite moment is half a segment, say) stops a tree, and the packer keeps only
+/// trees that pay.
+fn mass_row_seeds(program: &Program, targets: &[Target], n: usize, lanes: usize) -> Vec<Vec<u32>> {
+    if lanes < 2 || n < lanes + 1 {
+        return Vec::new();
+    }
+    let mut entry = vec![None; n * n];
+    for (out, target) in program.outputs.iter().zip(targets) {
+        if let (Operand::Tmp(k), Target::Mass { row, col }) = (out, target) {
+            entry[row * n + col] = Some(*k);
+        }
+    }
+    let mut seeds = Vec::new();
+    for shift in 0..lanes {
+        for row in 0..n {
+            let mut end = n - shift;
+            while end >= lanes && end - lanes > row {
+                let seed: Option<Vec<u32>> =
+                    (end - lanes..end).map(|c| entry[row * n + c]).collect();
+                seeds.extend(seed);
+                end -= lanes;
+            }
+        }
+    }
+    seeds
 }
 
 /// Statistics for `umgen`.
@@ -121,7 +164,7 @@ pub struct PluginHeader<'a> {
     pub fixed: Vec<(usize, f64)>,
 }
 
-pub(crate) fn units(d: &Derived) -> Vec<Unit> {
+pub(crate) fn units(d: &Derived, lanes: usize) -> Vec<Unit> {
     let n = d.dof;
     let nb6 = 6 * d.bodies;
     let mut dyn_out = Vec::new();
@@ -153,9 +196,9 @@ pub(crate) fn units(d: &Derived) -> Vec<Unit> {
     let mut all_t = dyn_t.clone();
     all_t.extend_from_slice(&kin_t);
     let mut units = vec![
-        Unit::new("dyn", &d.ctx, &dyn_out, dyn_t),
-        Unit::new("kin", &d.ctx, &kin_out, kin_t),
-        Unit::new("all", &d.ctx, &all_out, all_t),
+        Unit::new("dyn", &d.ctx, &dyn_out, dyn_t, n, lanes),
+        Unit::new("kin", &d.ctx, &kin_out, kin_t, n, lanes),
+        Unit::new("all", &d.ctx, &all_out, all_t, n, lanes),
     ];
     if !d.constraints.is_empty() {
         let nc = d.constraints.len();
@@ -173,9 +216,8 @@ pub(crate) fn units(d: &Derived) -> Vec<Unit> {
             out.push(*e);
             t.push(Target::ConstraintJacobian(c * nc + r));
         }
-        units.push(Unit::new("con", &d.ctx, &out, t));
+        units.push(Unit::new("con", &d.ctx, &out, t, n, lanes));
     }
-    let _ = n;
     units
 }
 
@@ -246,6 +288,72 @@ fn instr(i: &Instr, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
                 CasFunc::Abs => quote!(f64::abs(#a)),
             }
         }
+    }
+}
+
+/// One pack of [`Program::pack_lanes`]: lanes `start..start + w` of one operation as one
+/// `F64xW` operation, then the lanes as scalars (`t_k` for later scalar users, stores and
+/// scratch; unused ones cost nothing). A vector operand is the pack whose lanes the operands
+/// are, if it is computed in this function (`local_pack`), else the operand repeated (a
+/// splat) or gathered from scalars.
+fn vector_op(
+    prog: &Program,
+    start: usize,
+    w: usize,
+    local_pack: &dyn Fn(usize) -> bool,
+    local: &dyn Fn(u32) -> TokenStream,
+) -> TokenStream {
+    let ty = format_ident!("F64x{}", w);
+    let lane_operands = |pos: usize| -> Vec<Operand> {
+        (start..start + w)
+            .map(|k| match prog.instrs[k] {
+                Instr::Add(a, b) | Instr::Sub(a, b) | Instr::Mul(a, b) => [a, b][pos],
+                _ => unreachable!("packs are of binary operations"),
+            })
+            .collect()
+    };
+    let vector = |ops: Vec<Operand>| -> TokenStream {
+        if let Operand::Tmp(m) = ops[0]
+            && local_pack(m as usize)
+            && ops
+                .iter()
+                .enumerate()
+                .all(|(l, &o)| o == Operand::Tmp(m + l as u32))
+        {
+            let id = format_ident!("v{}", m);
+            return quote!(#id);
+        }
+        if ops.iter().all(|&o| o == ops[0]) {
+            let o = operand(ops[0], local);
+            return quote!(#ty::splat(#o));
+        }
+        let lanes = ops.iter().map(|&o| operand(o, local));
+        quote!(#ty::new([#(#lanes),*]))
+    };
+    let (a, b) = (vector(lane_operands(0)), vector(lane_operands(1)));
+    let lanes = &prog.instrs[start..start + w];
+    let e = if lanes.iter().all(|i| matches!(i, Instr::Mul(..))) {
+        quote!(#a.mul(#b))
+    } else if lanes.iter().all(|i| matches!(i, Instr::Add(..))) {
+        quote!(#a.add(#b))
+    } else if lanes.iter().all(|i| matches!(i, Instr::Sub(..))) {
+        quote!(#a.sub(#b))
+    } else {
+        // Additions and subtractions: a + s·b, s = ±1 per lane (exact: only the sign flips).
+        let signs = lanes.iter().map(|i| {
+            lit(if matches!(i, Instr::Sub(..)) {
+                -1.0
+            } else {
+                1.0
+            })
+        });
+        quote!(#a.add(#b.mul(#ty::new([#(#signs),*]))))
+    };
+    let id = format_ident!("v{}", start);
+    let names = (start..start + w).map(|k| format_ident!("t{}", k));
+    quote! {
+        let #id = #e;
+        let [#(#names),*] = #id.to_array();
     }
 }
 
@@ -343,9 +451,19 @@ fn emit_unit(
 ) -> TokenStream {
     let prog = &unit.program;
     let batch = unit.trig_batch.clone();
+    let w = unit.lanes;
+    let mut together: Vec<std::ops::Range<usize>> = unit.packs.iter().map(|&s| s..s + w).collect();
+    if !batch.is_empty() {
+        together.push(batch.clone());
+    }
+    together.sort_by_key(|r| r.start);
     let split = prog
-        .split_keeping(max_instrs.max(1), batch.clone())
+        .split_keeping(max_instrs.max(1), &together)
         .expect("max_instrs is at least 1");
+    // Pack starts, and the other lanes (defined by their pack's statement).
+    let pack_start: std::collections::HashSet<usize> = unit.packs.iter().copied().collect();
+    let in_pack: std::collections::HashSet<usize> =
+        unit.packs.iter().flat_map(|&s| s + 1..s + w).collect();
     let n_slots = split.n_slots.max(1);
     let mut fns = Vec::new();
     let mut calls = Vec::new();
@@ -390,10 +508,18 @@ fn emit_unit(
         let body = chunk
             .instrs
             .clone()
-            .filter(|k| !fused_skip.contains(k) && (!batch.contains(k) || *k == batch.start))
+            .filter(|k| {
+                !fused_skip.contains(k)
+                    && (!batch.contains(k) || *k == batch.start)
+                    && !in_pack.contains(k)
+            })
             .map(|k| {
                 if k == batch.start && !batch.is_empty() {
                     return trig_batch(prog, batch.clone(), &local);
+                }
+                if pack_start.contains(&k) {
+                    let local_pack = |m: usize| pack_start.contains(&m) && split.chunk_of(m) == ci;
+                    return vector_op(prog, k, w, &local_pack, &local);
                 }
                 if let Some(&(si, cj)) = fused_first.get(&k) {
                     let (sid, cid) = (format_ident!("t{}", si), format_ident!("t{}", cj));
@@ -490,13 +616,18 @@ fn c_string_list(names: &[String]) -> Literal {
 }
 
 /// Generates the whole plugin source (formatted).
-pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, EmitStats) {
+pub fn emit(
+    d: &Derived,
+    header: &PluginHeader,
+    max_instrs: usize,
+    lanes: usize,
+) -> (String, EmitStats) {
     let n = d.dof;
     let nb = d.bodies;
     let nc = d.constraints.len();
     let np = header.parameter_names.len();
     let start = std::time::Instant::now();
-    let units = units(d);
+    let units = units(d, lanes);
     let mut stats = EmitStats {
         cse_time: start.elapsed(),
         ..EmitStats::default()
@@ -753,6 +884,8 @@ pub fn emit(d: &Derived, header: &PluginHeader, max_instrs: usize) -> (String, E
     let mut text = prettyplease::unparse(&file);
     text.push('\n');
     text.push_str(crate::sin_cos::SOURCE);
+    text.push('\n');
+    text.push_str(crate::lanes::SOURCE);
     stats.source_lines = text.lines().count();
     stats.format_time = start.elapsed();
     (text, stats)

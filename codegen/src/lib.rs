@@ -12,6 +12,7 @@
 
 pub mod derive;
 pub mod emit;
+pub mod lanes;
 pub mod sin_cos;
 
 pub use derive::{DeriveOptions, Derived, derive};
@@ -123,7 +124,12 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
         parameter_names: model.parameters.iter().map(|p| p.name.clone()).collect(),
         fixed: fixed_idx.iter().map(|&i| (i, defaults[i])).collect(),
     };
-    let (source, stats) = emit::emit(&derived, &header, opts.max_instructions_per_function);
+    let (source, stats) = emit::emit(
+        &derived,
+        &header,
+        opts.max_instructions_per_function,
+        lanes::lanes_for(opts.portable),
+    );
     Ok(Generated {
         source,
         stats,
