@@ -469,6 +469,12 @@ fn emit_unit(
     let mut calls = Vec::new();
     // Each program output is written by the chunk that defines it (if it is a
     // temporary of that chunk) or after the last chunk from the scratch array.
+    let mut out_of_tmp: std::collections::HashMap<u32, Vec<usize>> = Default::default();
+    for (oi, out) in prog.outputs.iter().enumerate() {
+        if let Operand::Tmp(k) = out {
+            out_of_tmp.entry(*k).or_default().push(oi);
+        }
+    }
     let mut writes_in_chunk: Vec<Vec<(usize, u32)>> = vec![Vec::new(); split.chunks.len()];
     let mut final_writes = Vec::new();
     for (oi, out) in prog.outputs.iter().enumerate() {
@@ -545,8 +551,46 @@ fn emit_unit(
                 quote!(s[#s] = std::mem::MaybeUninit::new(#id);)
             });
         let mut buffers = std::collections::BTreeSet::new();
+        // Packs of mass entries M(r, c … c+w−1): one vector store of the mirrored entries
+        // M(c … c+w−1, r), adjacent in the column-major buffer, and scalar stores of the rest.
+        let mut vector_written: std::collections::HashSet<usize> = Default::default();
+        let mut vector_stores = Vec::new();
+        for &start in unit.packs.iter().filter(|&&s| split.chunk_of(s) == ci) {
+            let lanes: Option<Vec<(usize, usize, usize)>> = (start..start + w)
+                .map(|t| match out_of_tmp.get(&(t as u32)).map(Vec::as_slice) {
+                    Some(&[oi]) => match unit.targets[oi] {
+                        Target::Mass { row, col } if row < col => Some((oi, row, col)),
+                        _ => None,
+                    },
+                    _ => None,
+                })
+                .collect();
+            let Some(lanes) = lanes else { continue };
+            let (_, row, col) = lanes[0];
+            if !lanes
+                .iter()
+                .enumerate()
+                .all(|(l, &(_, r, c))| r == row && c == col + l)
+            {
+                continue;
+            }
+            let (a, b) = (row * n + col, row * n + col + w);
+            let v = format_ident!("v{}", start);
+            let upper = lanes.iter().enumerate().map(|(l, &(_, r, c))| {
+                let id = format_ident!("t{}", start + l);
+                let i = c * n + r;
+                quote!(mass[#i] = #id;)
+            });
+            vector_stores.push(quote! {
+                #v.store((&mut mass[#a..#b]).try_into().expect("a block of the mass buffer"));
+                #(#upper)*
+            });
+            vector_written.extend(lanes.iter().map(|l| l.0));
+            buffers.insert("mass");
+        }
         let writes: Vec<TokenStream> = writes_in_chunk[ci]
             .iter()
+            .filter(|(oi, _)| !vector_written.contains(oi))
             .map(|&(oi, k)| {
                 let id = format_ident!("t{}", k);
                 buffers.insert(buffer_name(unit.targets[oi]));
@@ -574,6 +618,7 @@ fn emit_unit(
                 #(#loads)*
                 #(#body)*
                 #(#stores)*
+                #(#vector_stores)*
                 #(#writes)*
             }
         });

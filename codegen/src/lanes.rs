@@ -42,6 +42,12 @@ mod tests {
             assert_eq!(x.mul(y).to_array()[l].to_bits(), (a[l] * b[l]).to_bits());
         }
         assert_eq!(F64x4::splat(-0.0).to_array(), [-0.0; 4]);
+        let mut out = [0.0; 4];
+        x.store(&mut out);
+        assert_eq!(out, a);
+        let mut two = [9.0; 2];
+        F64x2::new([b[2], b[3]]).store(&mut two);
+        assert_eq!(two, [b[2], b[3]]);
         assert_eq!(
             F64x2::splat(2.0).sub(F64x2::new([1.0, 3.0])).to_array(),
             [1.0, -1.0]

@@ -27,6 +27,10 @@ macro_rules! f64_lanes_array {
                 self.0
             }
             #[inline(always)]
+            pub(crate) fn store(self, out: &mut [f64; $w]) {
+                *out = self.0;
+            }
+            #[inline(always)]
             pub(crate) fn add(self, o: Self) -> Self {
                 let mut r = self.0;
                 for l in 0..$w {
@@ -55,7 +59,7 @@ macro_rules! f64_lanes_array {
 }
 
 macro_rules! f64_lanes_x86 {
-    ($name:ident, $w:literal, $reg:ident, $set:ident, $set1:ident, $add:ident, $sub:ident, $mul:ident) => {
+    ($name:ident, $w:literal, $reg:ident, $store:ident, $set1:ident, $add:ident, $sub:ident, $mul:ident) => {
         /// `$w` f64 lanes in one x86-64 vector register.
         #[derive(Clone, Copy, Debug)]
         pub(crate) struct $name(core::arch::x86_64::$reg);
@@ -75,6 +79,11 @@ macro_rules! f64_lanes_x86 {
             pub(crate) fn to_array(self) -> [f64; $w] {
                 // SAFETY: as in `new`.
                 unsafe { core::mem::transmute::<core::arch::x86_64::$reg, [f64; $w]>(self.0) }
+            }
+            #[inline(always)]
+            pub(crate) fn store(self, out: &mut [f64; $w]) {
+                // SAFETY: `out` holds `$w` f64 (unaligned store).
+                unsafe { core::arch::x86_64::$store(out.as_mut_ptr(), self.0) }
             }
             #[inline(always)]
             pub(crate) fn add(self, o: Self) -> Self {
@@ -102,10 +111,10 @@ macro_rules! f64_lanes_x86 {
 }
 
 #[cfg(target_arch = "x86_64")]
-f64_lanes_x86!(F64x2, 2, __m128d, _mm_setr_pd, _mm_set1_pd, _mm_add_pd, _mm_sub_pd, _mm_mul_pd);
+f64_lanes_x86!(F64x2, 2, __m128d, _mm_storeu_pd, _mm_set1_pd, _mm_add_pd, _mm_sub_pd, _mm_mul_pd);
 #[cfg(not(target_arch = "x86_64"))]
 f64_lanes_array!(F64x2, 2);
 #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-f64_lanes_x86!(F64x4, 4, __m256d, _mm256_setr_pd, _mm256_set1_pd, _mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd);
+f64_lanes_x86!(F64x4, 4, __m256d, _mm256_storeu_pd, _mm256_set1_pd, _mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd);
 #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
 f64_lanes_array!(F64x4, 4);
