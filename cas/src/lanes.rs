@@ -365,32 +365,7 @@ impl Program {
         if order.len() != n {
             return unpacked();
         }
-        let mut new_index = vec![0u32; n];
-        for (new, &old) in order.iter().enumerate() {
-            new_index[old as usize] = new as u32;
-        }
-        let remap = |o: Operand| match o {
-            Operand::Tmp(t) => Operand::Tmp(new_index[t as usize]),
-            other => other,
-        };
-        let instrs = order
-            .iter()
-            .map(|&old| {
-                let i = self.instrs[old as usize];
-                let swap = p.swapped[old as usize];
-                match i {
-                    Instr::Add(a, b) if swap => Instr::Add(remap(b), remap(a)),
-                    Instr::Mul(a, b) if swap => Instr::Mul(remap(b), remap(a)),
-                    Instr::Add(a, b) => Instr::Add(remap(a), remap(b)),
-                    Instr::Sub(a, b) => Instr::Sub(remap(a), remap(b)),
-                    Instr::Mul(a, b) => Instr::Mul(remap(a), remap(b)),
-                    Instr::Div(a, b) => Instr::Div(remap(a), remap(b)),
-                    Instr::Atan2(a, b) => Instr::Atan2(remap(a), remap(b)),
-                    Instr::Neg(a) => Instr::Neg(remap(a)),
-                    Instr::Call(f, a) => Instr::Call(f, remap(a)),
-                }
-            })
-            .collect();
+        let program = self.reordered(&order, |k| p.swapped[k]);
         let mut packs: Vec<usize> = (0..p.packs.len()).map(|g| start_of_group[g]).collect();
         packs.sort_unstable();
         let keep = keep
@@ -405,10 +380,7 @@ impl Program {
             })
             .collect();
         Packed {
-            program: Program {
-                instrs,
-                outputs: self.outputs.iter().map(|&o| remap(o)).collect(),
-            },
+            program,
             width,
             packs,
             keep,

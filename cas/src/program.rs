@@ -467,6 +467,38 @@ impl Program {
         out
     }
 
+    /// The program with its instructions in `order` (a permutation of the instructions that
+    /// keeps every operand before its user), temporaries renumbered; commutative instructions
+    /// `k` with `swap(k)` get their operands exchanged (bit-identical values).
+    pub(crate) fn reordered(&self, order: &[u32], swap: impl Fn(usize) -> bool) -> Program {
+        let mut new_index = vec![0u32; self.instrs.len()];
+        for (new, &old) in order.iter().enumerate() {
+            new_index[old as usize] = new as u32;
+        }
+        let remap = |o: Operand| match o {
+            Operand::Tmp(t) => Operand::Tmp(new_index[t as usize]),
+            other => other,
+        };
+        let instrs = order
+            .iter()
+            .map(|&old| match self.instrs[old as usize] {
+                Instr::Add(a, b) if swap(old as usize) => Instr::Add(remap(b), remap(a)),
+                Instr::Mul(a, b) if swap(old as usize) => Instr::Mul(remap(b), remap(a)),
+                Instr::Add(a, b) => Instr::Add(remap(a), remap(b)),
+                Instr::Sub(a, b) => Instr::Sub(remap(a), remap(b)),
+                Instr::Mul(a, b) => Instr::Mul(remap(a), remap(b)),
+                Instr::Div(a, b) => Instr::Div(remap(a), remap(b)),
+                Instr::Atan2(a, b) => Instr::Atan2(remap(a), remap(b)),
+                Instr::Neg(a) => Instr::Neg(remap(a)),
+                Instr::Call(f, a) => Instr::Call(f, remap(a)),
+            })
+            .collect();
+        Program {
+            instrs,
+            outputs: self.outputs.iter().map(|&o| remap(o)).collect(),
+        }
+    }
+
     /// The same program with every sin and cos whose argument needs no function call moved into
     /// one contiguous range of instructions, returned with it; a code generator can then compute
     /// them in one vectorized batch. The instructions the batched arguments depend on come
@@ -527,30 +559,8 @@ impl Program {
             placed[k] = true;
         }
         order.extend((0..n).filter(|&k| !placed[k]));
-        let mut new_index = vec![0u32; n];
-        for (new, &old) in order.iter().enumerate() {
-            new_index[old] = new as u32;
-        }
-        let remap = |o: Operand| match o {
-            Operand::Tmp(t) => Operand::Tmp(new_index[t as usize]),
-            other => other,
-        };
-        let instrs = order
-            .iter()
-            .map(|&old| match self.instrs[old] {
-                Instr::Add(a, b) => Instr::Add(remap(a), remap(b)),
-                Instr::Sub(a, b) => Instr::Sub(remap(a), remap(b)),
-                Instr::Mul(a, b) => Instr::Mul(remap(a), remap(b)),
-                Instr::Div(a, b) => Instr::Div(remap(a), remap(b)),
-                Instr::Atan2(a, b) => Instr::Atan2(remap(a), remap(b)),
-                Instr::Neg(a) => Instr::Neg(remap(a)),
-                Instr::Call(f, a) => Instr::Call(f, remap(a)),
-            })
-            .collect();
-        let program = Program {
-            instrs,
-            outputs: self.outputs.iter().map(|&o| remap(o)).collect(),
-        };
+        let order: Vec<u32> = order.iter().map(|&k| k as u32).collect();
+        let program = self.reordered(&order, |_| false);
         (program, start..end)
     }
 
