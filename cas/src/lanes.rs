@@ -87,7 +87,49 @@ struct Packer<'a> {
 
 const NONE: u32 = u32::MAX;
 
-impl Packer<'_> {
+/// What a tree being grown has added so far (see [`Packer::undo`]).
+#[derive(Clone, Copy)]
+struct Mark {
+    packs: usize,
+    swaps: usize,
+    built: usize,
+}
+
+impl<'a> Packer<'a> {
+    fn new(prog: &'a Program, width: usize) -> Self {
+        let n = prog.instrs.len();
+        Packer {
+            prog,
+            width,
+            pack_of: vec![NONE; n],
+            packs: Vec::new(),
+            swapped: vec![false; n],
+            tentative_swaps: Vec::new(),
+            built: Vec::new(),
+            stamp: vec![0; n],
+            generation: 0,
+        }
+    }
+
+    fn mark(&self) -> Mark {
+        Mark {
+            packs: self.packs.len(),
+            swaps: self.tentative_swaps.len(),
+            built: self.built.len(),
+        }
+    }
+
+    /// Drops the packs, swaps and vectors added since `mark`.
+    fn undo(&mut self, mark: Mark) {
+        for pack in self.packs.drain(mark.packs..) {
+            for t in pack {
+                self.pack_of[t as usize] = NONE;
+            }
+        }
+        self.tentative_swaps.truncate(mark.swaps);
+        self.built.truncate(mark.built);
+    }
+
     /// How alike two operands are, for orienting commutative lanes.
     fn likeness(&self, a: Operand, b: Operand) -> u8 {
         match (a, b) {
@@ -177,11 +219,7 @@ impl Packer<'_> {
         if !same || distinct.len() != tmps.len() || !self.independent(&tmps) {
             return gather(self);
         }
-        let mark = (
-            self.packs.len(),
-            self.tentative_swaps.len(),
-            self.built.len(),
-        );
+        let mark = self.mark();
         let id = self.packs.len() as u32;
         for &t in &tmps {
             self.pack_of[t as usize] = id;
@@ -215,19 +253,16 @@ impl Packer<'_> {
         let packed = w - 1 - i64::from(mixed) + self.grow(&c0) + self.grow(&c1);
         // Gathering the lanes here instead may be cheaper than the subtree (which then
         // gathers several vectors further down): undo it.
-        let gathering = if self.built[..mark.2].iter().any(|b| b.as_slice() == lanes) {
+        let gathering = if self.built[..mark.built]
+            .iter()
+            .any(|b| b.as_slice() == lanes)
+        {
             0
         } else {
             -w
         };
         if packed < gathering {
-            for pack in self.packs.drain(mark.0..) {
-                for t in pack {
-                    self.pack_of[t as usize] = NONE;
-                }
-            }
-            self.tentative_swaps.truncate(mark.1);
-            self.built.truncate(mark.2);
+            self.undo(mark);
             return gather(self);
         }
         packed
@@ -265,36 +300,22 @@ impl Program {
         if width < 2 || seeds.is_empty() {
             return unpacked();
         }
-        let mut p = Packer {
-            prog: self,
-            width,
-            pack_of: vec![NONE; n],
-            packs: Vec::new(),
-            swapped: vec![false; n],
-            tentative_swaps: Vec::new(),
-            built: Vec::new(),
-            stamp: vec![0; n],
-            generation: 0,
-        };
+        let mut p = Packer::new(self, width);
         for seed in seeds {
             if seed.len() != width || seed.iter().any(|&t| t as usize >= n) {
                 continue;
             }
-            let committed = p.packs.len();
             p.tentative_swaps.clear();
             p.built.clear();
+            let start = p.mark();
             let lanes: Vec<Operand> = seed.iter().map(|&t| Operand::Tmp(t)).collect();
             let saved = p.grow(&lanes);
-            if saved > 0 && p.packs.len() > committed {
+            if saved > 0 && p.packs.len() > start.packs {
                 for &t in &p.tentative_swaps {
                     p.swapped[t as usize] = true;
                 }
             } else {
-                for pack in p.packs.drain(committed..) {
-                    for t in pack {
-                        p.pack_of[t as usize] = NONE;
-                    }
-                }
+                p.undo(start);
             }
         }
         if p.packs.is_empty() {
@@ -407,18 +428,7 @@ mod tests {
             ],
             outputs: vec![Operand::Tmp(4)],
         };
-        let n = prog.instrs.len();
-        let mut p = Packer {
-            prog: &prog,
-            width: 2,
-            pack_of: vec![NONE; n],
-            packs: Vec::new(),
-            swapped: vec![false; n],
-            tentative_swaps: Vec::new(),
-            built: Vec::new(),
-            stamp: vec![0; n],
-            generation: 0,
-        };
+        let mut p = Packer::new(&prog, 2);
         assert!(p.independent(&[0, 2]));
         assert!(p.independent(&[1, 3]));
         assert!(!p.independent(&[0, 1]), "t1 reads t0");

@@ -40,6 +40,8 @@ pub(crate) struct Unit {
     pub lanes: usize,
     /// First instructions of the packs (each `lanes` instructions computed as one vector).
     pub packs: Vec<usize>,
+    /// Ranges each function must hold whole: the packs and the batch ([`railmbs_cas::Packed::together`]).
+    pub together: Vec<std::ops::Range<usize>>,
 }
 
 impl Unit {
@@ -54,13 +56,15 @@ impl Unit {
         let (program, trig_batch) = Program::compile(ctx, outputs).batch_sin_cos();
         let seeds = mass_row_seeds(&program, &targets, n, lanes);
         let packed = program.pack_lanes(&seeds, lanes, std::slice::from_ref(&trig_batch));
+        let together = packed.together();
         Unit {
             name,
-            program: packed.program,
             targets,
             trig_batch: packed.keep[0].clone(),
             lanes: packed.width,
             packs: packed.packs,
+            program: packed.program,
+            together,
         }
     }
 }
@@ -452,13 +456,8 @@ fn emit_unit(
     let prog = &unit.program;
     let batch = unit.trig_batch.clone();
     let w = unit.lanes;
-    let mut together: Vec<std::ops::Range<usize>> = unit.packs.iter().map(|&s| s..s + w).collect();
-    if !batch.is_empty() {
-        together.push(batch.clone());
-    }
-    together.sort_by_key(|r| r.start);
     let split = prog
-        .split_keeping(max_instrs.max(1), &together)
+        .split_keeping(max_instrs.max(1), &unit.together)
         .expect("max_instrs is at least 1");
     // Pack starts, and the other lanes (defined by their pack's statement).
     let pack_start: std::collections::HashSet<usize> = unit.packs.iter().copied().collect();
