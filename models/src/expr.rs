@@ -147,29 +147,24 @@ impl Expr {
     /// True if the expression contains the leaf `leaf` (`Time`, a `Param` or
     /// a `Var`).
     fn depends_on(&self, leaf: &Expr) -> bool {
-        match self {
-            Expr::Num(_) => false,
-            Expr::Param(_) | Expr::Time | Expr::Var(_) => self == leaf,
-            Expr::Neg(a) | Expr::Call(_, a) => a.depends_on(leaf),
-            Expr::Add(a, b)
-            | Expr::Sub(a, b)
-            | Expr::Mul(a, b)
-            | Expr::Div(a, b)
-            | Expr::Pow(a, b) => a.depends_on(leaf) || b.depends_on(leaf),
-        }
+        self.any_leaf(&|e| e == leaf)
     }
 
     /// True if the expression uses a local variable (`Var`).
     pub fn has_vars(&self) -> bool {
+        self.any_leaf(&|e| matches!(e, Expr::Var(_)))
+    }
+
+    /// True if some leaf (`Num`, `Param`, `Time` or `Var`) satisfies `pred`.
+    fn any_leaf(&self, pred: &impl Fn(&Expr) -> bool) -> bool {
         match self {
-            Expr::Num(_) | Expr::Param(_) | Expr::Time => false,
-            Expr::Var(_) => true,
-            Expr::Neg(a) | Expr::Call(_, a) => a.has_vars(),
+            Expr::Num(_) | Expr::Param(_) | Expr::Time | Expr::Var(_) => pred(self),
+            Expr::Neg(a) | Expr::Call(_, a) => a.any_leaf(pred),
             Expr::Add(a, b)
             | Expr::Sub(a, b)
             | Expr::Mul(a, b)
             | Expr::Div(a, b)
-            | Expr::Pow(a, b) => a.has_vars() || b.has_vars(),
+            | Expr::Pow(a, b) => a.any_leaf(pred) || b.any_leaf(pred),
         }
     }
 
