@@ -478,6 +478,24 @@ fn time_engine(
     Ok((eval_ns, Some(dynamics_ns)))
 }
 
+/// Median wall time of `run` (one simulation: its seconds and steps), repeated until
+/// [`MAX_RUNS`] runs or [`RUN_SECONDS`] in all, and the steps of a run.
+fn median_run(
+    mut run: impl FnMut() -> Result<(f64, usize), String>,
+) -> Result<(f64, usize), String> {
+    let mut steps = 0;
+    let mut times = Vec::new();
+    let mut total = 0.0;
+    while times.len() < MAX_RUNS && (times.is_empty() || total < RUN_SECONDS) {
+        let (seconds, n) = run()?;
+        steps = n;
+        total += seconds;
+        times.push(seconds);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok((times[times.len() / 2], steps))
+}
+
 /// Median time of `run_scenario` (no CSV output) with engines from `make`, s,
 /// and the number of steps of a run.
 fn time_run(
@@ -485,10 +503,7 @@ fn time_run(
     model: &Model,
     make: &dyn Fn() -> Result<Box<dyn Equations>, String>,
 ) -> Result<(f64, usize), String> {
-    let mut steps = 0;
-    let mut times = Vec::new();
-    let mut total = 0.0;
-    while times.len() < MAX_RUNS && (times.is_empty() || total < RUN_SECONDS) {
+    median_run(|| {
         let equations = make()?;
         let watch = Stopwatch::start();
         let summary =
@@ -496,15 +511,11 @@ fn time_run(
         // The runner's own timer is wall-clock; the stopwatch also counts
         // the setup (state, system) of the run, which is small.
         let seconds = watch.seconds();
-        if let Some(e) = summary.error {
-            return Err(format!("the scenario run failed: {e}"));
+        match summary.error {
+            Some(e) => Err(format!("the scenario run failed: {e}")),
+            None => Ok((seconds, summary.steps)),
         }
-        steps = summary.steps;
-        total += seconds;
-        times.push(seconds);
-    }
-    times.sort_by(f64::total_cmp);
-    Ok((times[times.len() / 2], steps))
+    })
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -598,24 +609,17 @@ fn time_train_run(
     make: &VehicleEngines,
 ) -> Result<(f64, usize), String> {
     let refs: Vec<&Model> = models.iter().collect();
-    let mut steps = 0;
-    let mut times = Vec::new();
-    let mut total = 0.0;
-    while times.len() < MAX_RUNS && (times.is_empty() || total < RUN_SECONDS) {
+    median_run(|| {
         let engines = models.iter().map(make).collect::<Result<Vec<_>, _>>()?;
         let watch = Stopwatch::start();
         let summary = railmbs_runtime::train::run_train(train, &refs, engines, None, |_| {})
             .map_err(|e| e.to_string())?;
         let seconds = watch.seconds();
-        if let Some(e) = summary.error {
-            return Err(format!("the train run failed: {e}"));
+        match summary.error {
+            Some(e) => Err(format!("the train run failed: {e}")),
+            None => Ok((seconds, summary.steps)),
         }
-        steps = summary.steps;
-        total += seconds;
-        times.push(seconds);
-    }
-    times.sort_by(f64::total_cmp);
-    Ok((times[times.len() / 2], steps))
+    })
 }
 
 /// `measure` for a train file: evaluations summed over the vehicles, the
