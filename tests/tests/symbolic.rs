@@ -74,18 +74,9 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
                 );
             }
             close(&es.jacobians, &en.jacobians, "Γ", &model.name);
-            for (a, b) in es.bodies.iter().zip(&en.bodies) {
-                let pa = DMatrix::from_iterator(
-                    18,
-                    1,
-                    a.position
-                        .iter()
-                        .chain(a.rotation.iter())
-                        .chain(a.velocity.iter())
-                        .chain(a.angular_velocity.iter())
-                        .copied(),
-                );
-                let pb = DMatrix::from_iterator(
+            // Position, rotation, velocity and angular velocity of a body as one column.
+            let stacked = |b: &railmbs_runtime::BodyKinematics| {
+                DMatrix::from_iterator(
                     18,
                     1,
                     b.position
@@ -94,7 +85,10 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
                         .chain(b.velocity.iter())
                         .chain(b.angular_velocity.iter())
                         .copied(),
-                );
+                )
+            };
+            for (a, b) in es.bodies.iter().zip(&en.bodies) {
+                let (pa, pb) = (stacked(a), stacked(b));
                 close(&pa, &pb, "body kinematics", &model.name);
             }
             if num.constraint_count() > 0 {
