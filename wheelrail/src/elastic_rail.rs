@@ -556,16 +556,13 @@ pub fn solve_from(
             let c = &geo[i];
             let [ny, nz] = c.normal;
             let t = [nz, -ny];
-            let (f, _) = creep_force(i, c, normal[i], material, law, vel, t, settings.v_roll)?;
+            let (f, lateral_slope) =
+                creep_force(i, c, normal[i], material, law, vel, t, settings.v_roll)?;
             change = change.max((f.fy - creep[i].fy).abs().max((f.fx - creep[i].fx).abs()));
             scale = scale.max(normal[i]);
             creep[i] = f;
             creep_t[i] = f.fy;
-            slope[i] = if normal[i] > 0.0 {
-                lateral_creep_coefficient(c, normal[i], material, vel, t, settings.v_roll, &f)
-            } else {
-                0.0
-            };
+            slope[i] = lateral_slope;
             creep_g[i] = rate(slope[i]);
         }
         d_lin = d;
@@ -652,7 +649,10 @@ fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
 }
 
 /// Creep forces of contact `i` for normal force `nn`; the rail's velocity
-/// `vel` moves the rail's material point, `Δη = −(vel·t)/V`.
+/// `vel` moves the rail's material point, `Δη = −(vel·t)/V`. Also −∂T/∂η (N)
+/// of the lateral creep force: Kalker's f₂₂ = G a b C₂₂ scaled by the
+/// saturation |F|/|F_linear| (≤ 1) of the law's force; 0 without load or
+/// where Kalker's table does not apply.
 #[allow(clippy::too_many_arguments)]
 fn creep_force(
     i: usize,
@@ -685,42 +685,24 @@ fn creep_force(
     let f = law
         .forces_at_speed(&patch, &cr, v_roll)
         .map_err(|e| contact_err(i, e))?;
-    Ok((f, hc.a))
+    let lateral_slope = KalkerCoefficients::saturated_slopes(
+        hc.a,
+        hc.b,
+        material.g,
+        material.nu,
+        cr.xi,
+        cr.eta,
+        f.fx,
+        f.fy,
+    )
+    .map_or(0.0, |(_, f22)| f22);
+    Ok((f, lateral_slope))
 }
 
 /// The lateral creep force of a contact at rail displacement `d`, to first
 /// order about `d_lin` where it is `t0` with slope `g` along `t`.
 fn linear_creep(t0: f64, g: f64, t: [f64; 2], d: [f64; 2], d_lin: [f64; 2]) -> f64 {
     t0 + g * (t[0] * (d[0] - d_lin[0]) + t[1] * (d[1] - d_lin[1]))
-}
-
-/// −∂T/∂η (N) of a contact's lateral creep force: Kalker's f₂₂ = G a b C₂₂
-/// scaled by the saturation |F|/|F_linear| (≤ 1) of the law's force `f`;
-/// 0 where Kalker's table does not apply.
-fn lateral_creep_coefficient(
-    c: &RailContact,
-    nn: f64,
-    material: &ContactMaterial,
-    vel: [f64; 2],
-    t: [f64; 2],
-    v_roll: f64,
-    f: &CreepForces,
-) -> f64 {
-    let Ok(hc) = c.hertz.contact(nn) else {
-        return 0.0;
-    };
-    let eta = c.creepages.eta - (vel[0] * t[0] + vel[1] * t[1]) / v_roll;
-    KalkerCoefficients::saturated_slopes(
-        hc.a,
-        hc.b,
-        material.g,
-        material.nu,
-        c.creepages.xi,
-        eta,
-        f.fx,
-        f.fy,
-    )
-    .map_or(0.0, |(_, f22)| f22)
 }
 
 /// The Newton step −J⁻¹ r of a 2×2 system.
