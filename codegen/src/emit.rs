@@ -361,6 +361,48 @@ fn vector_op(
     }
 }
 
+/// The stores of a pack whose lanes are the mass entries M(r, c … c+w−1) (each lane one output,
+/// r < c): one vector store of the mirrored entries M(c … c+w−1, r), adjacent in the
+/// column-major buffer, and scalar stores of the others; with the outputs they write. `None`
+/// for any other pack.
+fn mass_pack_store(
+    unit: &Unit,
+    start: usize,
+    n: usize,
+    out_of_tmp: &std::collections::HashMap<u32, Vec<usize>>,
+) -> Option<(TokenStream, Vec<usize>)> {
+    let w = unit.lanes;
+    let lanes: Vec<(usize, usize, usize)> = (start..start + w)
+        .map(|t| match out_of_tmp.get(&(t as u32)).map(Vec::as_slice) {
+            Some(&[oi]) => match unit.targets[oi] {
+                Target::Mass { row, col } if row < col => Some((oi, row, col)),
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect::<Option<_>>()?;
+    let (_, row, col) = lanes[0];
+    if !lanes
+        .iter()
+        .enumerate()
+        .all(|(l, &(_, r, c))| r == row && c == col + l)
+    {
+        return None;
+    }
+    let (a, b) = (row * n + col, row * n + col + w);
+    let v = format_ident!("v{}", start);
+    let upper = lanes.iter().enumerate().map(|(l, &(_, r, c))| {
+        let id = format_ident!("t{}", start + l);
+        let i = c * n + r;
+        quote!(mass[#i] = #id;)
+    });
+    let tokens = quote! {
+        #v.store((&mut mass[#a..#b]).try_into().expect("a block of the mass buffer"));
+        #(#upper)*
+    };
+    Some((tokens, lanes.iter().map(|l| l.0).collect()))
+}
+
 /// The batch of sin and cos calls `range` of `prog` (all `Call(Sin | Cos, _)`): one
 /// `sin_cos_batch` call over their distinct arguments, then one `let` per instruction.
 fn trig_batch(
@@ -469,16 +511,14 @@ fn emit_unit(
     // Each program output is written by the chunk that defines it (if it is a
     // temporary of that chunk) or after the last chunk from the scratch array.
     let mut out_of_tmp: std::collections::HashMap<u32, Vec<usize>> = Default::default();
-    for (oi, out) in prog.outputs.iter().enumerate() {
-        if let Operand::Tmp(k) = out {
-            out_of_tmp.entry(*k).or_default().push(oi);
-        }
-    }
     let mut writes_in_chunk: Vec<Vec<(usize, u32)>> = vec![Vec::new(); split.chunks.len()];
     let mut final_writes = Vec::new();
     for (oi, out) in prog.outputs.iter().enumerate() {
         match out {
-            Operand::Tmp(k) => writes_in_chunk[split.chunk_of(*k as usize)].push((oi, *k)),
+            Operand::Tmp(k) => {
+                out_of_tmp.entry(*k).or_default().push(oi);
+                writes_in_chunk[split.chunk_of(*k as usize)].push((oi, *k));
+            }
             other => final_writes.push((oi, *other)),
         }
     }
@@ -555,37 +595,11 @@ fn emit_unit(
         let mut vector_written: std::collections::HashSet<usize> = Default::default();
         let mut vector_stores = Vec::new();
         for &start in unit.packs.iter().filter(|&&s| split.chunk_of(s) == ci) {
-            let lanes: Option<Vec<(usize, usize, usize)>> = (start..start + w)
-                .map(|t| match out_of_tmp.get(&(t as u32)).map(Vec::as_slice) {
-                    Some(&[oi]) => match unit.targets[oi] {
-                        Target::Mass { row, col } if row < col => Some((oi, row, col)),
-                        _ => None,
-                    },
-                    _ => None,
-                })
-                .collect();
-            let Some(lanes) = lanes else { continue };
-            let (_, row, col) = lanes[0];
-            if !lanes
-                .iter()
-                .enumerate()
-                .all(|(l, &(_, r, c))| r == row && c == col + l)
-            {
-                continue;
+            if let Some((tokens, outputs)) = mass_pack_store(unit, start, n, &out_of_tmp) {
+                vector_stores.push(tokens);
+                vector_written.extend(outputs);
+                buffers.insert("mass");
             }
-            let (a, b) = (row * n + col, row * n + col + w);
-            let v = format_ident!("v{}", start);
-            let upper = lanes.iter().enumerate().map(|(l, &(_, r, c))| {
-                let id = format_ident!("t{}", start + l);
-                let i = c * n + r;
-                quote!(mass[#i] = #id;)
-            });
-            vector_stores.push(quote! {
-                #v.store((&mut mass[#a..#b]).try_into().expect("a block of the mass buffer"));
-                #(#upper)*
-            });
-            vector_written.extend(lanes.iter().map(|l| l.0));
-            buffers.insert("mass");
         }
         let writes: Vec<TokenStream> = writes_in_chunk[ci]
             .iter()
