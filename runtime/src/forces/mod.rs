@@ -267,6 +267,25 @@ impl<'a> ForceJacobian<'a> {
         }
     }
 
+    /// Starts a point pair: H = G = Γ_P₂ − Γ_P₁ (3 rows) for the point `p1`
+    /// (SC0) of `body1` and `p2` of `body2`; false (nothing started) when both
+    /// are ground.
+    fn begin_point_pair(
+        &mut self,
+        body1: Option<usize>,
+        p1: &Vector3<f64>,
+        body2: Option<usize>,
+        p2: &Vector3<f64>,
+    ) -> bool {
+        if body1.is_none() && body2.is_none() {
+            return false;
+        }
+        self.begin(body1, body2, 3);
+        self.point_rows(0, body2, p2, 1.0);
+        self.point_rows(0, body1, p1, -1.0);
+        true
+    }
+
     /// Adds `sign`·Γ_r of `body` to rows row0..row0+3 of H.
     fn rotation_rows(&mut self, row0: usize, body: Option<usize>, sign: f64) {
         let Some(b) = body else { return };
@@ -331,12 +350,9 @@ impl<'a> ForceJacobian<'a> {
         kq: &Matrix3<f64>,
         kv: &Matrix3<f64>,
     ) {
-        if body1.is_none() && body2.is_none() {
+        if !self.begin_point_pair(body1, p1, body2, p2) {
             return;
         }
-        self.begin(body1, body2, 3);
-        self.point_rows(0, body2, p2, 1.0);
-        self.point_rows(0, body1, p1, -1.0);
         self.project(3, |r, c| kq[(r, c)], |r, c| kv[(r, c)]);
     }
 
@@ -386,12 +402,9 @@ impl<'a> ForceJacobian<'a> {
         dq_row: &Vector3<f64>,
         dv_row: &Vector3<f64>,
     ) {
-        if body1.is_none() && body2.is_none() {
+        if !self.begin_point_pair(body1, p1, body2, p2) {
             return;
         }
-        self.begin(body1, body2, 3);
-        self.point_rows(0, body2, p2, 1.0);
-        self.point_rows(0, body1, p1, -1.0);
         let s = &*self.scratch;
         let m = s.cols.len();
         for (ci, &i) in s.cols.iter().enumerate() {
