@@ -6,11 +6,12 @@
 //! under a constant Coulomb force), which follows in closed form from the
 //! energy balance over the half cycle.
 
+mod common;
+
+use common::*;
 use std::ops::ControlFlow;
-use std::path::Path;
 
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{ModelSystem, NumericEquations};
 
 /// A 1 kg mass on a line tied to the ground by the load-dependent friction
 /// element: spring c1 in series with (spring c2 ∥ friction μ·c2·x2).
@@ -50,11 +51,7 @@ fn closed_form_ratio(c1: f64, c2: f64, mu: f64) -> f64 {
 
 #[test]
 fn load_friction_free_vibration_decays_geometrically() {
-    let model = railmbs_models::parse_model(MODEL, Path::new("decay.ron")).unwrap();
-    let params = model.parameter_values(&[], &[]).unwrap();
-    let (q0, v0) = model.initial_state(&params);
-    let mut sys =
-        ModelSystem::new(&model, Box::new(NumericEquations::new(&model)), params).unwrap();
+    let (mut sys, q0, v0) = system(&parse(MODEL), &[]);
     let settings = ParkSettings {
         max_step: 2e-5,
         jacobian: JacobianKind::Analytic,
