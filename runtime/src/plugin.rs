@@ -117,7 +117,10 @@ pub enum PluginError {
 }
 
 /// Whether this CPU has the target feature `name` (rustc's name, e.g. `avx2`): `None` if
-/// the loader cannot tell (a name it does not know, or not an x86-64 machine).
+/// the loader cannot tell (a name it does not know, or not an x86-64 machine). It knows every
+/// x86-64 feature `-C target-cpu=native` enables that `is_x86_feature_detected!` checks on
+/// stable Rust, a superset of what plugins report today (`codegen::emit`'s list; a test in
+/// `tests/tests/plugins.rs` keeps it so), so the plugins' list can grow without a new loader.
 pub fn host_has_target_feature(name: &str) -> Option<bool> {
     #[cfg(target_arch = "x86_64")]
     {
@@ -180,15 +183,6 @@ pub fn host_has_target_feature(name: &str) -> Option<bool> {
         let _ = name;
         None
     }
-}
-
-/// The features of a plugin's `railmbs_target_features` list this CPU lacks or cannot confirm.
-fn missing_target_features(list: &str) -> Vec<String> {
-    list.split(',')
-        .map(str::trim)
-        .filter(|f| !f.is_empty() && host_has_target_feature(f) != Some(true))
-        .map(str::to_owned)
-        .collect()
 }
 
 fn c_str(p: *const c_char) -> String {
@@ -262,14 +256,19 @@ impl Plugin {
         // SAFETY: the signature is that of the ABI; the function reads nothing.
         if let Ok(features) = unsafe { lib.get::<TargetFeaturesFn>(b"railmbs_target_features\0") } {
             // SAFETY: a NUL-terminated static string of the plugin.
-            let list = c_str(unsafe { features() });
-            let missing = missing_target_features(&list);
-            target_features = Some(
-                list.split(',')
-                    .filter(|f| !f.is_empty())
-                    .map(str::to_owned)
-                    .collect(),
-            );
+            let list: Vec<String> = c_str(unsafe { features() })
+                .split(',')
+                .map(str::trim)
+                .filter(|f| !f.is_empty())
+                .map(str::to_owned)
+                .collect();
+            // The ones this CPU lacks or the loader cannot confirm.
+            let missing: Vec<String> = list
+                .iter()
+                .filter(|f| host_has_target_feature(f) != Some(true))
+                .cloned()
+                .collect();
+            target_features = Some(list);
             if !missing.is_empty() {
                 return Err(PluginError::CpuFeatures {
                     path: path.to_path_buf(),
