@@ -235,6 +235,12 @@ impl WheelsetState {
     fn side(&self, side: usize) -> &[ContactState] {
         &self.contacts[side][..self.count[side]]
     }
+
+    /// Adds a loaded contact to side 0 (left) or 1 (right).
+    fn push(&mut self, side: usize, contact: ContactState) {
+        self.contacts[side][self.count[side]] = contact;
+        self.count[side] += 1;
+    }
 }
 
 /// One side (wheel and rail) of the wheelset at one state: what its contacts
@@ -670,9 +676,7 @@ impl WheelRailContact {
                             forces,
                             (damper_power, 0.4 * elastic * k.approach),
                         )?;
-                        let n = state.count[side];
-                        state.contacts[side][n] = st;
-                        state.count[side] += 1;
+                        state.push(side, st);
                     }
                 }
             }
@@ -818,9 +822,7 @@ impl WheelRailContact {
                 r.creep,
                 (0.0, 0.4 * r.normal_force * r.approach),
             )?;
-            let n = state.count[s.side];
-            state.contacts[s.side][n] = st;
-            state.count[s.side] += 1;
+            state.push(s.side, st);
         }
         Ok(())
     }
