@@ -404,6 +404,29 @@ impl SlidingMeans {
             max_sum_y: (f64::NEG_INFINITY, f64::NAN),
         }
     }
+
+    /// Adds an accepted step at time `t` (s) and distance `s` (m) with the
+    /// wheel loads (Q, Y) per side (N); a time before the last starts over
+    /// (a new run).
+    fn push(&mut self, t: f64, s: f64, loads: &[(f64, f64); 2]) {
+        if t < self.last_t {
+            *self = Self::new();
+        }
+        self.last_t = t;
+        for (side, &(q, y)) in loads.iter().enumerate() {
+            let ratio = if q > 0.0 { y / q } else { 0.0 };
+            if let Some(v) = self.y_over_q[side].push(s, ratio)
+                && v > self.max_y_over_q[side].0
+            {
+                self.max_y_over_q[side] = (v, t);
+            }
+        }
+        if let Some(v) = self.sum_y.push(s, loads[0].1 - loads[1].1)
+            && v.abs() > self.max_sum_y.0
+        {
+            self.max_sum_y = (v.abs(), t);
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -1282,26 +1305,9 @@ impl ForceElement for WheelRailContact {
             .as_ref()
             .and_then(|b| b.speed.motion(ctx.t).ok().map(|m| m.s + b.offset));
         if let Some(s) = s {
-            let means = self
-                .means
-                .get_or_insert_with(|| Box::new(SlidingMeans::new()));
-            if ctx.t < means.last_t {
-                **means = SlidingMeans::new();
-            }
-            means.last_t = ctx.t;
-            for (side, &(q, y)) in loads.iter().enumerate() {
-                let ratio = if q > 0.0 { y / q } else { 0.0 };
-                if let Some(v) = means.y_over_q[side].push(s, ratio)
-                    && v > means.max_y_over_q[side].0
-                {
-                    means.max_y_over_q[side] = (v, ctx.t);
-                }
-            }
-            if let Some(v) = means.sum_y.push(s, loads[0].1 - loads[1].1)
-                && v.abs() > means.max_sum_y.0
-            {
-                means.max_sum_y = (v.abs(), ctx.t);
-            }
+            self.means
+                .get_or_insert_with(|| Box::new(SlidingMeans::new()))
+                .push(ctx.t, s, &loads);
         }
         // Elastic rails: this step's rail displacements become the start of
         // the next step's damper rate (never changed inside Newton
