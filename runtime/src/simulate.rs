@@ -714,7 +714,6 @@ pub(crate) fn write_row_text(
     })
 }
 
-/// Runs `scenario` on `model` with the engine `equations` and writes the output
 /// Integrates from breakpoint to breakpoint (kinks of the track) up to
 /// `t_end`, restarting after each with the velocities `restart` gives
 /// (continuous absolute velocities); adds each segment's counts to `summary`
@@ -891,6 +890,7 @@ impl OutputSchedule {
     }
 }
 
+/// Runs `scenario` on `model` with the engine `equations` and writes the output
 /// CSV to `output` (if given). `progress` is called with the simulated time
 /// now and then. A simulation error stops the run: rows up to that point are
 /// written, and the summary carries the error.
