@@ -274,11 +274,11 @@ impl Columns {
     pub(crate) fn values(
         &self,
         system: &mut ModelSystem,
-        row: &Row,
+        row: RowView,
         values: &mut Vec<f64>,
         force_values: &mut Vec<f64>,
     ) -> Result<(), RunError> {
-        let (t, q, v) = (row.t, row.q.as_slice(), row.v.as_slice());
+        let (t, q, v) = (row.t, row.q, row.v);
         if self.coordinates {
             values.extend_from_slice(q);
         }
@@ -316,7 +316,7 @@ impl Columns {
 /// track-frame inputs as well, O(ε²) truncation, rounding ~1e-16·|v|/ε.
 fn accelerations(
     system: &mut ModelSystem,
-    row: &Row,
+    row: RowView,
     points: &[(usize, Vector3<f64>)],
     values: &mut Vec<f64>,
 ) -> Result<(), RunError> {
@@ -325,12 +325,12 @@ fn accelerations(
         (
             row.q
                 .iter()
-                .zip(&row.v)
+                .zip(row.v)
                 .map(|(q, v)| q + sign * eps * v)
                 .collect(),
             row.v
                 .iter()
-                .zip(&row.a)
+                .zip(row.a)
                 .map(|(v, a)| v + sign * eps * a)
                 .collect(),
         )
@@ -344,7 +344,7 @@ fn accelerations(
             .collect())
     };
     let (plus, minus) = (at(1.0)?, at(-1.0)?);
-    let e = system.evaluate(row.t, &row.q, &row.v, Parts::KINEMATICS)?;
+    let e = system.evaluate(row.t, row.q, row.v, Parts::KINEMATICS)?;
     for ((b, _), (vp, vm)) in points.iter().zip(plus.iter().zip(&minus)) {
         let a = e.bodies[*b].rotation.transpose() * ((vp - vm) / (2.0 * eps));
         values.extend(a.iter());
@@ -594,7 +594,7 @@ impl Recorder {
             if let Some(arc) = &cols.arc {
                 values.push(arc_position(arc, row.t)?);
             }
-            cols.values(system, row, values, force_values)
+            cols.values(system, row.slice(0..row.q.len()), values, force_values)
         });
     }
 }
@@ -781,6 +781,28 @@ pub(crate) struct Row {
     pub q: Vec<f64>,
     pub v: Vec<f64>,
     pub a: Vec<f64>,
+}
+
+impl Row {
+    /// The coordinates `r` of the row (one vehicle's part of a train's row),
+    /// borrowed.
+    pub(crate) fn slice(&self, r: std::ops::Range<usize>) -> RowView<'_> {
+        RowView {
+            t: self.t,
+            q: &self.q[r.clone()],
+            v: &self.v[r.clone()],
+            a: &self.a[r],
+        }
+    }
+}
+
+/// A borrowed [`Row`] or part of one: time (s), q, q̇ and q̈.
+#[derive(Clone, Copy)]
+pub(crate) struct RowView<'a> {
+    pub t: f64,
+    pub q: &'a [f64],
+    pub v: &'a [f64],
+    pub a: &'a [f64],
 }
 
 /// Rows waiting to be written.

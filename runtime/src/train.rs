@@ -25,7 +25,7 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::simulate::{
-    Columns, CsvSink, OutputSchedule, Row, RunError, RunSummary, arc_position, check_integrator,
+    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, check_integrator,
     columns, continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
 };
 use crate::system::{MechanicalSystem, SimError};
@@ -465,14 +465,8 @@ impl TrainRecorder {
                 values.push(arc_position(arc, row.t)? - offset);
             }
             for (k, cols) in columns.iter().enumerate() {
-                let r = train.range(k);
-                let vehicle_row = Row {
-                    t: row.t,
-                    q: row.q[r.clone()].to_vec(),
-                    v: row.v[r.clone()].to_vec(),
-                    a: row.a[r].to_vec(),
-                };
-                cols.values(train.vehicle_mut(k), &vehicle_row, values, force_values)?;
+                let vehicle_row = row.slice(train.range(k));
+                cols.values(train.vehicle_mut(k), vehicle_row, values, force_values)?;
             }
             Ok(train.coupler_outputs(row.t, &row.q, &row.v, values)?)
         });
