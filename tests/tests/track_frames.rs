@@ -174,28 +174,21 @@ fn tc1_free_body_error(tol: f64) -> (f64, usize) {
         summary.rejected_steps, 0,
         "steps rejected at the track's kinks"
     );
-    let text = std::fs::read_to_string(&out).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (ct, cx, cy, cz) = (
-        col("time"),
-        col("body.x[m]"),
-        col("body.y[m]"),
-        col("body.z[m]"),
+    let table = Table::read(&out);
+    let (time, x, y, z) = (
+        table.col("time"),
+        table.col("body.x[m]"),
+        table.col("body.y[m]"),
+        table.col("body.z[m]"),
     );
     let mut worst: f64 = 0.0;
-    let mut rows = 0;
-    for line in lines {
-        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-        let t = v[ct];
+    for (k, &t) in time.iter().enumerate() {
         worst = worst
-            .max((v[cx] - (11.0 + 4.4 * t)).abs())
-            .max(v[cy].abs())
-            .max(v[cz].abs());
-        rows += 1;
+            .max((x[k] - (11.0 + 4.4 * t)).abs())
+            .max(y[k].abs())
+            .max(z[k].abs());
     }
-    (worst, rows)
+    (worst, table.rows.len())
 }
 
 #[test]
