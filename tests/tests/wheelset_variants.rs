@@ -39,17 +39,21 @@ fn standing(path: &str, extra: &[(&str, &str)], end_time: f64) -> Table {
         set_parameters(s, &p);
         s.end_time = end_time;
         s.output.interval = 0.01;
-        // Tight enough that the integration's error (a wobble of the vertical
-        // mode at the size of atol times the 1e8 N/m support, ±10 N at the
-        // scenario's atol = 1e-7 m) stays below 1e-6 of the wheel load.
-        s.integrator = IntegratorSpec::Park {
-            rtol: 1e-7,
-            atol: 1e-10,
-            max_step: 0.005,
-            initial_step: None,
-            jacobian: Default::default(),
-        };
+        s.integrator = tight_park();
     })
+}
+
+/// Park's method tight enough that the integration's error (a wobble of the
+/// vertical mode at the size of atol times the 1e8 N/m support, ±10 N at the
+/// scenarios' atol = 1e-7 m) stays below 1e-6 of the wheel load.
+fn tight_park() -> IntegratorSpec {
+    IntegratorSpec::Park {
+        rtol: 1e-7,
+        atol: 1e-10,
+        max_step: 0.005,
+        initial_step: None,
+        jacobian: Default::default(),
+    }
 }
 
 /// Static wheel load of [`standing`], N.
@@ -653,13 +657,7 @@ fn elastic_rails_balance_a_lateral_axle_force_on_the_flange_root() {
         );
         s.end_time = 0.5;
         s.output.interval = 0.01;
-        s.integrator = IntegratorSpec::Park {
-            rtol: 1e-7,
-            atol: 1e-10,
-            max_step: 0.005,
-            initial_step: None,
-            jacobian: Default::default(),
-        };
+        s.integrator = tight_park();
     });
     let (dl, dr) = (
         last(&t, "contact.L.rail_dy [m]"),
