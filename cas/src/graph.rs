@@ -225,55 +225,42 @@ impl PartialEq for Node {
     }
 }
 
-/// Small multiplicative hasher (FxHash-like); nodes are hashed once on interning.
-#[derive(Clone, Copy)]
-struct Fx(u64);
-
-impl Fx {
-    const K: u64 = 0x517c_c1b7_2722_0a95;
-    fn add(&mut self, w: u64) {
-        self.0 = (self.0.rotate_left(5) ^ w).wrapping_mul(Self::K);
-    }
-    fn finish(self) -> u64 {
-        // Fold the well-mixed high bits into the low bits used for table indices.
-        self.0 ^ (self.0 >> 32)
-    }
-}
-
+/// A node's hash for the interning table (nodes are hashed once, on interning).
 fn hash_node(n: &Node) -> u64 {
-    let mut h = Fx(0);
+    use std::hash::Hasher;
+    let mut h = rustc_hash::FxHasher::default();
     match n {
         Node::Num(v) => {
-            h.add(1);
-            h.add(v.to_bits());
+            h.write_u64(1);
+            h.write_u64(v.to_bits());
         }
         Node::Sym(s) => {
-            h.add(2);
-            h.add(s.kind as u64);
-            h.add(s.index as u64);
+            h.write_u64(2);
+            h.write_u64(s.kind as u64);
+            h.write_u64(s.index as u64);
         }
         Node::Add { constant, terms } => {
-            h.add(3);
-            h.add(constant.to_bits());
+            h.write_u64(3);
+            h.write_u64(constant.to_bits());
             for (b, c) in terms.iter() {
-                h.add(b.0 as u64);
-                h.add(c.to_bits());
+                h.write_u64(b.0 as u64);
+                h.write_u64(c.to_bits());
             }
         }
         Node::Mul { factors } => {
-            h.add(4);
+            h.write_u64(4);
             for (b, k) in factors.iter() {
-                h.add(((b.0 as u64) << 32) | (*k as u32 as u64));
+                h.write_u64(((b.0 as u64) << 32) | (*k as u32 as u64));
             }
         }
         Node::Call(f, a) => {
-            h.add(5);
-            h.add(*f as u64);
-            h.add(a.0 as u64);
+            h.write_u64(5);
+            h.write_u64(*f as u64);
+            h.write_u64(a.0 as u64);
         }
         Node::Atan2(y, x) => {
-            h.add(6);
-            h.add(((y.0 as u64) << 32) | x.0 as u64);
+            h.write_u64(6);
+            h.write_u64(((y.0 as u64) << 32) | x.0 as u64);
         }
     }
     h.finish()
@@ -281,46 +268,7 @@ fn hash_node(n: &Node) -> u64 {
 
 /// `BuildHasher` for the crate's internal maps (keys are small integers; SipHash's
 /// DoS-resistance is not needed and costs a large share of CSE time).
-#[derive(Clone, Copy, Default)]
-pub(crate) struct FxBuild;
-
-pub(crate) struct FxHasher(Fx);
-
-impl std::hash::Hasher for FxHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut b = [0u8; 8];
-            b[..chunk.len()].copy_from_slice(chunk);
-            self.0.add(u64::from_le_bytes(b));
-        }
-    }
-    fn write_u8(&mut self, i: u8) {
-        self.0.add(i as u64)
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.0.add(i as u64)
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0.add(i)
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.0.add(i as u64)
-    }
-    fn write_isize(&mut self, i: isize) {
-        self.0.add(i as u64)
-    }
-    fn finish(&self) -> u64 {
-        // hashbrown indexes with the low bits: move the well-mixed high bits down.
-        self.0.0.rotate_left(26)
-    }
-}
-
-impl std::hash::BuildHasher for FxBuild {
-    type Hasher = FxHasher;
-    fn build_hasher(&self) -> FxHasher {
-        FxHasher(Fx(0))
-    }
-}
+pub(crate) type FxBuild = rustc_hash::FxBuildHasher;
 
 /// Hash map with [`FxBuild`].
 pub(crate) type FxMap<K, V> = std::collections::HashMap<K, V, FxBuild>;

@@ -180,7 +180,10 @@ impl Builder {
             instrs: Vec::with_capacity(capacity),
             depth: Vec::with_capacity(capacity),
             share,
-            vn: FxMap::with_capacity_and_hasher(if share { capacity } else { 0 }, FxBuild),
+            vn: FxMap::with_capacity_and_hasher(
+                if share { capacity } else { 0 },
+                FxBuild::default(),
+            ),
             pows: FxMap::default(),
         }
     }

@@ -605,5 +605,8 @@ fn abs_of_an_identically_zero_argument_counts_as_a_kink() {
     let mut c = Context::new();
     let e = build(&mut c, &t);
     let d = c.diff(e, SYMS[0]);
-    assert!(c.eval(&[d], &values(&[0.0; 5])).is_err(), "0/0 is refused, not returned");
+    assert!(
+        c.eval(&[d], &values(&[0.0; 5])).is_err(),
+        "0/0 is refused, not returned"
+    );
 }
