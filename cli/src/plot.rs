@@ -101,29 +101,22 @@ pub struct PanelSpec {
     pub columns: Vec<usize>,
 }
 
-/// Whether `name` matches `pattern`, where `*` matches any (possibly empty)
-/// run of characters and every other character matches itself.
+/// A column-name pattern: `*` matches any (possibly empty) run of characters and
+/// every other character matches itself (column names hold brackets and slashes,
+/// `B1.WS1.contact.L.Y/Q [-]`, so they are escaped rather than read as glob syntax).
+pub fn column_pattern(pattern: &str) -> globset::GlobMatcher {
+    let escaped: Vec<String> = pattern.split('*').map(globset::escape).collect();
+    globset::GlobBuilder::new(&escaped.join("*"))
+        .literal_separator(false)
+        .backslash_escape(false)
+        .build()
+        .expect("an escaped pattern is valid")
+        .compile_matcher()
+}
+
+/// Whether `name` matches `pattern` (see [`column_pattern`]).
 pub fn glob_match(pattern: &str, name: &str) -> bool {
-    let p: Vec<char> = pattern.chars().collect();
-    let n: Vec<char> = name.chars().collect();
-    let (mut i, mut j) = (0, 0);
-    let mut star: Option<(usize, usize)> = None;
-    while j < n.len() {
-        if i < p.len() && p[i] == '*' {
-            star = Some((i, j));
-            i += 1;
-        } else if i < p.len() && p[i] == n[j] {
-            i += 1;
-            j += 1;
-        } else if let Some((si, sj)) = star {
-            i = si + 1;
-            j = sj + 1;
-            star = Some((si, sj + 1));
-        } else {
-            return false;
-        }
-    }
-    p[i..].iter().all(|&c| c == '*')
+    column_pattern(pattern).is_match(name)
 }
 
 /// The fewest edits turning `piece` into some substring of `text`.
@@ -213,8 +206,9 @@ pub fn resolve_panel(
             return Err(format!("--y \"{spec}\": empty column name"));
         }
         if item.contains('*') {
+            let pattern = column_pattern(item);
             let found: Vec<usize> = (0..header.len())
-                .filter(|&k| k != skip && glob_match(item, &header[k]))
+                .filter(|&k| k != skip && pattern.is_match(&header[k]))
                 .collect();
             if found.is_empty() {
                 return Err(format!(
@@ -870,6 +864,11 @@ mod tests {
         assert!(!glob_match("B1.*.L.Y/Q [-]", "B1.WS1.contact.R.Y/Q [-]"));
         assert!(glob_match("*a*a", "banana"));
         assert!(!glob_match("a*b", "acbc"));
+        // glob syntax other than `*` is literal: brackets, braces, `?`, backslashes
+        assert!(glob_match("s[m]", "s[m]"));
+        assert!(!glob_match("s[m]", "sm"));
+        assert!(glob_match("*{a,b}?\\*", "x{a,b}?\\y"));
+        assert!(!glob_match("a?", "ab"));
     }
 
     #[test]
