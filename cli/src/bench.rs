@@ -39,53 +39,25 @@ use railmbs_runtime::{Equations, Evaluation, MechanicalSystem, ModelSystem, Part
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// CPU time of the calling thread, s (`CLOCK_THREAD_CPUTIME_ID`), or `None`
-/// where unavailable.
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn thread_cpu_seconds() -> Option<f64> {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    unsafe extern "C" {
-        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
-    }
-    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime only writes the timespec we own; on 64-bit Linux
-    // (glibc and musl) struct timespec is two 64-bit integers.
-    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
-}
-
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn thread_cpu_seconds() -> Option<f64> {
-    None
-}
-
-/// A stopwatch on the thread's CPU clock, or on the wall clock where there is
-/// none.
+/// A stopwatch on the thread's CPU clock (the `cpu-time` crate), or on the wall
+/// clock where the platform has none.
 struct Stopwatch {
-    cpu: Option<f64>,
+    cpu: Option<cpu_time::ThreadTime>,
     wall: Instant,
 }
 
 impl Stopwatch {
     fn start() -> Self {
         Self {
-            cpu: thread_cpu_seconds(),
+            cpu: cpu_time::ThreadTime::try_now().ok(),
             wall: Instant::now(),
         }
     }
     /// Seconds since `start`.
     fn seconds(&self) -> f64 {
-        match (self.cpu, thread_cpu_seconds()) {
-            (Some(a), Some(b)) => b - a,
-            _ => self.wall.elapsed().as_secs_f64(),
+        match &self.cpu {
+            Some(t) => t.elapsed().as_secs_f64(),
+            None => self.wall.elapsed().as_secs_f64(),
         }
     }
 }
