@@ -1,7 +1,7 @@
 //! # railmbs-codegen
 //!
 //! The symbolic path: from a validated [`Model`] to the equations of motion as
-//! expressions ([`derive`], with the `cas` crate), to optimized straight-line
+//! expressions ([`derive`](mod@derive), with the `cas` crate), to optimized straight-line
 //! Rust ([`emit`]: common-subexpression elimination over all outputs, split into
 //! functions of bounded size), to a compiled, cached `cdylib` plugin
 //! ([`build_plugin`], with `build-support`). The `umgen` binary (crate `cli`)

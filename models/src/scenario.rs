@@ -739,7 +739,7 @@ pub fn load_train(path: &Path) -> Result<TrainScenario, ModelErrors> {
 
 /// Resolves train text; `path` is the train file (for errors and relative
 /// paths). Vehicle and coupler names are checked here; body names of
-/// couplers against the models by [`TrainScenario::resolve_couplers`].
+/// couplers against the models by [`TrainScenario::resolve_coupler`].
 pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors> {
     let loc = Locator::new(text);
     let raw: RawTrain = ron::Options::default()

@@ -81,7 +81,7 @@ impl PiecewiseLinear {
         (self.y[i + 1] - self.y[i]) / (self.x[i + 1] - self.x[i])
     }
 
-    /// ∫ from x[0] to `x` of y (negative for x < x[0]).
+    /// ∫ from `x[0]` to `x` of y (negative for x < `x[0]`).
     pub fn integral(&self, x: f64) -> f64 {
         let n = self.x.len();
         if x <= self.x[0] {

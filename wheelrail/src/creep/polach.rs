@@ -118,7 +118,7 @@ impl Polach {
         Self::default()
     }
 
-    /// With [P05]'s reduction factors of the initial slope: `k_A` in the area of
+    /// With \[P05\]'s reduction factors of the initial slope: `k_A` in the area of
     /// adhesion and `k_S` in the area of slip, each in (0, 1] (the paper has
     /// `k_S ≤ k_A ≤ 1`). The small-creepage slope becomes `(k_A + k_S)/2` times
     /// Kalker's.
@@ -133,7 +133,7 @@ impl Polach {
         Ok(self)
     }
 
-    /// With [P05]'s exponential friction decrease `μ = μ0[(1 − A)e^(−B w) + A]`:
+    /// With \[P05\]'s exponential friction decrease `μ = μ0[(1 − A)e^(−B w) + A]`:
     /// `mu_ratio` = `A = μ∞/μ0` (≥ 0), `decay` = `B` in s/m (≥ 0), `speed` = `V`
     /// in m/s (≥ 0) giving the slip velocity `w = s_C V`.
     pub fn with_falling_friction(
