@@ -1,7 +1,7 @@
 //! Validation of the friction, contact and tabulated force elements: each
 //! check names the element and the field, at its position in the file.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_models::ForceKind;

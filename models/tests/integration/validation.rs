@@ -1,6 +1,6 @@
 //! Every validation error names the file, the element and the position.
 
-mod common;
+use crate::common;
 
 use common::*;
 

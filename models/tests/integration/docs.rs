@@ -4,7 +4,7 @@ use railmbs_models::*;
 
 /// The ```ron blocks of the crate docs, without the `//! ` prefix.
 fn ron_blocks() -> Vec<String> {
-    let lib = include_str!("../src/lib.rs");
+    let lib = include_str!("../../src/lib.rs");
     let mut blocks = Vec::new();
     let mut current: Option<String> = None;
     for line in lib.lines() {

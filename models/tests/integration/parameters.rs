@@ -1,6 +1,6 @@
 //! Parameter values with macros and overrides; structural hash.
 
-mod common;
+use crate::common;
 
 use common::*;
 

@@ -1,6 +1,6 @@
 //! Scenario files: syntax, defaults, validation, resolution against a model.
 
-mod common;
+use crate::common;
 
 use common::FULL;
 use railmbs_models::*;

@@ -3,7 +3,7 @@
 //! (E.A.H. Vollebregt, CONTACT, `../shared/reference/contact`), and the
 //! saturation limit μN (Coulomb).
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_wheelrail::creep::{

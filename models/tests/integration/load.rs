@@ -1,6 +1,6 @@
 //! Loading every construct of the model language.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_models::*;

@@ -3,10 +3,10 @@
 //! creepage), Polach's 2005 friction decrease formula at full sliding, and
 //! CONTACT's exact results (`../shared/reference/contact`, E.A.H. Vollebregt).
 
+use crate::common;
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, KalkerLinear, Polach,
 };
-mod common;
 
 use common::*;
 

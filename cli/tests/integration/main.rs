@@ -1,0 +1,8 @@
+//! The integration tests of `cli`, one module per topic, linked into one
+//! test binary.
+
+mod bench_cli;
+mod conicity_cli;
+mod creep_cli;
+mod plot_cli;
+mod run_cli;

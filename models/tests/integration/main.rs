@@ -1,0 +1,13 @@
+//! The integration tests of `models`, one module per topic, linked into one
+//! test binary.
+
+mod bundled;
+mod common;
+mod docs;
+mod expr;
+mod force_validation;
+mod load;
+mod parameters;
+mod scenario;
+mod subsystems;
+mod validation;

@@ -1,0 +1,12 @@
+//! The integration tests of `wheelrail`, one module per topic, linked into one
+//! test binary.
+
+mod common;
+mod conicity_en15302;
+mod creep;
+mod creepage;
+mod elastic_rail;
+mod geometry_contact;
+mod hertz;
+mod polach;
+mod profile_reading;
