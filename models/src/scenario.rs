@@ -92,6 +92,40 @@ pub struct ScenarioTrack {
     /// held before the first and after the last (e.g. a slow deceleration to
     /// find a critical speed). Empty for constant speed.
     pub speed_profile: Vec<(f64, f64)>,
+    /// The track itself, read from `file`, validated and built when the
+    /// scenario is loaded (with its measured irregularities, if any).
+    pub track: Arc<Track>,
+}
+
+/// A scenario's track settings, validated, before the track file is read.
+struct PendingTrack {
+    file: PathBuf,
+    start: f64,
+    speed: f64,
+    speed_profile: Vec<(f64, f64)>,
+}
+
+impl PendingTrack {
+    /// Reads, parses and builds the track file: RON errors with line and
+    /// column, build errors (geometry, irregularity files) naming the file.
+    fn load(self) -> Result<ScenarioTrack, ModelErrors> {
+        let text = crate::error::read_text(&self.file, "track")?;
+        let loc = Locator::new(&text);
+        let description: TrackDescription = ron::Options::default()
+            .from_str(&text)
+            .map_err(|e| ron_error(&loc, &self.file, e))?;
+        let base = self.file.parent().unwrap_or(Path::new(""));
+        let track = description
+            .build(base)
+            .map_err(|e| ModelErrors(vec![ModelError::new(&self.file, "track", e.to_string())]))?;
+        Ok(ScenarioTrack {
+            file: self.file,
+            start: self.start,
+            speed: self.speed,
+            speed_profile: self.speed_profile,
+            track: Arc::new(track),
+        })
+    }
 }
 
 /// A resolved scenario.
@@ -125,8 +159,10 @@ use crate::load::ron_error;
 use crate::locate::Locator;
 use crate::model::Model;
 use crate::raw::{OrderedMap, Value};
+use railmbs_track::{Track, TrackDescription};
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
+use std::sync::Arc;
 
 fn some<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Option<T>, D::Error> {
     T::deserialize(d).map(Some)
@@ -277,6 +313,7 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
         errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
         return Err(ModelErrors(errors));
     }
+    let track = track.map(PendingTrack::load).transpose()?;
     let dir = path.parent().unwrap_or(Path::new(""));
     Ok(Scenario {
         source: path.to_path_buf(),
@@ -304,7 +341,7 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
 struct Common {
     integrator: IntegratorSpec,
     output: OutputSpec,
-    track: Option<ScenarioTrack>,
+    track: Option<PendingTrack>,
     parameters: Vec<(String, String)>,
 }
 
@@ -420,7 +457,7 @@ fn common(
             "speed",
             format!("track speed must be finite, got {speed} m/s"),
         );
-        ScenarioTrack {
+        PendingTrack {
             file: path.parent().unwrap_or(Path::new("")).join(t.file),
             start: t.start,
             speed,
@@ -961,6 +998,7 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         errors.sort_by_key(|e| e.position.unwrap_or((usize::MAX, usize::MAX)));
         return Err(ModelErrors(errors));
     }
+    let track = track.expect("a train always has a track").load()?;
     Ok(TrainScenario {
         source: path.to_path_buf(),
         vehicles,
@@ -970,7 +1008,7 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         integrator,
         output,
         output_file: raw.output_file.map(|f| dir.join(f)),
-        track: track.expect("a train always has a track"),
+        track,
     })
 }
 

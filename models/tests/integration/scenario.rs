@@ -252,3 +252,62 @@ fn unknown_macro_parameter_or_coordinate_in_scenario() {
     assert!(errs.0[0].message.contains("unknown coordinate"));
     assert_eq!(errs.0[1].element, "initial \"x\"");
 }
+
+/// A scenario on the track file `track` (written beside the scenario as
+/// `track.ron` when given).
+fn track_scenario(s: &Scratch, track: Option<&str>) -> PathBuf {
+    if let Some(text) = track {
+        std::fs::write(s.0.join("scenarios/track.ron"), text).unwrap();
+    }
+    s.scenario(
+        "on_track.ron",
+        r#"Scenario(
+    model: "../mechanisms/everything.ron",
+    end_time: 1.0,
+    integrator: Rk4(step: 0.001),
+    output: (interval: 0.01),
+    track: (file: "track.ron", start: 10.0, speed: 20.0),
+)"#,
+    )
+}
+
+#[test]
+fn the_track_file_is_read_and_built_when_the_scenario_loads() {
+    let s = Scratch::new("track-ok");
+    let path = track_scenario(
+        &s,
+        Some("Custom((sections: [Straight(length: 120.0), Straight(length: 30.0)]))"),
+    );
+    let sc = load_scenario(&path).unwrap_or_else(|e| panic!("{e}"));
+    let track = sc.track.expect("a track");
+    assert_eq!(track.file, s.0.join("scenarios/track.ron"));
+    // the built track is the file's: 120 m + 30 m
+    assert!(
+        (track.track.length() - 150.0).abs() < 1e-12,
+        "{}",
+        track.track.length()
+    );
+}
+
+#[test]
+fn a_bad_track_file_is_a_load_error_with_its_file_line_and_column() {
+    let s = Scratch::new("track-bad");
+    // RON syntax: the error names the track file and the position of `Straigt`
+    let path = track_scenario(
+        &s,
+        Some("Custom((\n    sections: [Straigt(length: 5.0)],\n))"),
+    );
+    let e = load_scenario(&path).unwrap_err();
+    let err = &e.0[0];
+    assert_eq!(err.file, s.0.join("scenarios/track.ron"));
+    assert_eq!(err.position.map(|p| p.0), Some(2), "{e}");
+    // invalid geometry: named file and element
+    let path = track_scenario(&s, Some("Custom((sections: [Straight(length: -5.0)]))"));
+    let e = load_scenario(&path).unwrap_err();
+    assert_eq!(e.0[0].file, s.0.join("scenarios/track.ron"));
+    assert_eq!(e.0[0].element, "track");
+    // a missing file
+    std::fs::remove_file(s.0.join("scenarios/track.ron")).unwrap();
+    let e = load_scenario(&path).unwrap_err();
+    assert!(e.to_string().contains("cannot read the track file"), "{e}");
+}
