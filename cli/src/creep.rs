@@ -29,7 +29,7 @@ use std::path::PathBuf;
 pub enum Method {
     /// Kalker's linear theory.
     Kalker,
-    /// Kalker's linear force saturated towards μN (exponent 3).
+    /// Kalker's linear force saturated towards μN (exponent 2).
     Mueller,
     /// Kalker's FASTSIM, strips × elements, parabolic traction bound.
     Fastsim,
