@@ -17,14 +17,21 @@
 //!   closed-form strips, cost proportional to the number of strips only;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
 //!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
+//!
+//! [`CreepLawSpec`] names a law and its settings (model files, command line)
+//! and builds it.
 
 mod fastsim;
 mod fastsim_a;
 mod polach;
+mod spec;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
 pub use polach::Polach;
+pub use spec::{
+    CREEP_LAW_SYNTAX, CreepLawSpec, FASTSIM_A_STRIPS, FASTSIM_DIVISIONS, ParseCreepLawError,
+};
 
 pub use crate::creepage::Creepages;
 use crate::kalker::KalkerCoefficients;

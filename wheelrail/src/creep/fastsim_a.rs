@@ -117,10 +117,12 @@ pub struct FastsimA {
 
 /// How FastSim_A obtains the traction direction in the sliding zone of each
 /// strip (see the module documentation for the measured errors).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SlidingZone {
     /// The adhesion-continuation direction, integrated in closed form (the
-    /// original FastSim_A of this crate; fastest).
+    /// original FastSim_A of this crate; fastest; the default).
+    #[default]
     Continuation,
     /// One Picard step of the direction ODE from the continuation direction,
     /// `nodes` Gauss nodes per zone (measured: no better than
