@@ -56,9 +56,10 @@ pub struct Args {
     /// Creep-force law.
     #[arg(long, value_enum)]
     pub method: Method,
-    /// Number of strips (FASTSIM, FastSim_A).
-    #[arg(long, default_value_t = 10)]
-    pub strips: usize,
+    /// Number of strips (FASTSIM: default 10, FastSim_A: default 20, as in
+    /// model files and `umsim bench --creep`).
+    #[arg(long)]
+    pub strips: Option<usize>,
     /// Number of elements per strip (FASTSIM).
     #[arg(long, default_value_t = 10)]
     pub elements: usize,
@@ -190,9 +191,13 @@ pub fn evaluate<R: Read, W: Write>(
 
 /// Runs `umsim creep`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let strips = args.strips.unwrap_or(match args.method {
+        Method::FastsimA => railmbs_wheelrail::creep::FASTSIM_A_STRIPS,
+        _ => railmbs_wheelrail::creep::FASTSIM_DIVISIONS,
+    });
     let law = law_with_sliding(
         args.method,
-        args.strips,
+        strips,
         args.elements,
         args.sliding,
         args.nodes,
