@@ -79,6 +79,7 @@ use railmbs_wheelrail::creep::{
     ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
     Polach, SlidingZone,
 };
+use railmbs_wheelrail::creepage::ContactFrame;
 use railmbs_wheelrail::elastic_rail::{
     self, ContactMaterial, CreepStart, ElasticRailError, ElasticRailSettings, RailContact,
     RailContactGeometry, RailSupport,
@@ -923,11 +924,17 @@ impl WheelRailContact {
         // does not feed the spin into the normal damper.
         let omega_frame = wheel.angular_velocity - s.axle * wheel.angular_velocity.dot(&s.axle);
         let approach_rate = -(wheel.velocity + omega_frame.cross(&rho)).dot(&n);
-        let creepages = Creepages {
-            xi: v_wheel.dot(&ex) / s.speed,
-            eta: v_wheel.dot(&ey) / s.speed,
-            phi: wheel.angular_velocity.dot(&n) / s.speed,
+        // Against a rail at rest (the elastic rail's velocity is added by
+        // its solve).
+        let frame = ContactFrame {
+            ex: ex.into(),
+            ey: ey.into(),
+            n: n.into(),
         };
+        let omega = wheel.angular_velocity.into();
+        let creepages =
+            Creepages::from_velocities(v_wheel.into(), [0.0; 3], omega, [0.0; 3], &frame, s.speed)
+                .map_err(|e| self.diverged(t, e.to_string()))?;
         Ok(Some(ContactKinematics {
             shape,
             approach,
