@@ -76,8 +76,7 @@ use nalgebra::{Matrix3, Vector3};
 use railmbs_models::{CreepLawKind, RailKind, SlidingZoneKind, WheelRail};
 use railmbs_track::{SpeedLaw, Track};
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
-    Polach, SlidingZone,
+    ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages, SlidingZone,
 };
 use railmbs_wheelrail::creepage::ContactFrame;
 use railmbs_wheelrail::elastic_rail::{
@@ -1026,6 +1025,33 @@ impl WheelRailContact {
     }
 }
 
+/// The wheelrail crate's spec of a model's creep law, with Mueller's
+/// `exponent` evaluated.
+fn creep_spec(kind: &CreepLawKind, exponent: f64) -> CreepLawSpec {
+    match *kind {
+        CreepLawKind::Kalker => CreepLawSpec::Kalker,
+        CreepLawKind::Mueller { .. } => CreepLawSpec::Mueller { exponent },
+        CreepLawKind::Fastsim { nx, ny } => CreepLawSpec::Fastsim { nx, ny },
+        CreepLawKind::FastsimA { strips, sliding } => CreepLawSpec::FastsimA {
+            strips,
+            sliding: match sliding {
+                SlidingZoneKind::Continuation => SlidingZone::Continuation,
+                SlidingZoneKind::Integrated { nodes } => SlidingZone::Integrated { nodes },
+                SlidingZoneKind::Picard { nodes } => SlidingZone::Picard { nodes },
+            },
+        },
+        CreepLawKind::Polach {
+            ka,
+            ks,
+            friction_decrease,
+        } => CreepLawSpec::Polach {
+            ka,
+            ks,
+            friction_decrease,
+        },
+    }
+}
+
 /// Nadal's limit of Y/Q for flange angle `beta` (rad) and friction `mu`:
 /// (tan β − μ)/(1 + μ tan β) (Nadal 1908).
 pub fn nadal_limit(beta: f64, mu: f64) -> f64 {
@@ -1145,38 +1171,9 @@ impl ForceElement for WheelRailContact {
             ));
         };
         let contact = self.prepare(binding)?;
-        let law: Box<dyn CreepLaw + Send + Sync> = match &self.spec.creep {
-            CreepLawKind::Kalker => Box::new(KalkerLinear),
-            CreepLawKind::Mueller { .. } => {
-                Box::new(Mueller::new(self.c.exponent).map_err(|e| self.err(e))?)
-            }
-            CreepLawKind::Fastsim { nx, ny } => {
-                Box::new(Fastsim::new(*ny, *nx).map_err(|e| self.err(e))?)
-            }
-            CreepLawKind::FastsimA { strips, sliding } => {
-                let zone = match *sliding {
-                    SlidingZoneKind::Continuation => SlidingZone::Continuation,
-                    SlidingZoneKind::Integrated { nodes } => SlidingZone::Integrated { nodes },
-                    SlidingZoneKind::Picard { nodes } => SlidingZone::Picard { nodes },
-                };
-                Box::new(
-                    FastsimA::new(*strips)
-                        .and_then(|f| f.with_sliding(zone))
-                        .map_err(|e| self.err(e))?,
-                )
-            }
-            CreepLawKind::Polach {
-                ka,
-                ks,
-                friction_decrease,
-            } => {
-                let mut p = Polach::new().with_reduction(*ka, *ks);
-                if let Some((a, b)) = friction_decrease {
-                    p = p.and_then(|p| p.with_falling_friction(*a, *b, 0.0));
-                }
-                Box::new(p.map_err(|e| self.err(e))?)
-            }
-        };
+        let law = creep_spec(&self.spec.creep, self.c.exponent)
+            .build()
+            .map_err(|e| self.err(e))?;
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
         self.bound = Some(Bound {
             track: binding.track.clone(),
