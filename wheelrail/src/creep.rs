@@ -13,7 +13,7 @@
 //!   [`crate::kalker`];
 //! - [`Mueller`]: the linear force saturated towards `μN`;
 //! - [`Fastsim`]: Kalker's FASTSIM algorithm (simplified theory);
-//! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (seed paper Sect. 4.3):
+//! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (Pogorelov 2005, Sect. 4.3):
 //!   closed-form strips, cost proportional to the number of strips only;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
 //!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
