@@ -145,34 +145,11 @@ pub struct Args {
 
 /// Parses `--creep`: a creep law in the syntax of
 /// [`railmbs_wheelrail::creep::CreepLawSpec`] (as `umsim creep --method`).
-pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
-    use railmbs_models::{CreepLawKind, Expr, SlidingZoneKind};
-    use railmbs_wheelrail::creep::{CreepLawSpec, SlidingZone};
-    let spec: CreepLawSpec = text.parse().map_err(|e| format!("--creep: {e}"))?;
-    Ok(match spec {
-        CreepLawSpec::Kalker => CreepLawKind::Kalker,
-        CreepLawSpec::Mueller { exponent } => CreepLawKind::Mueller {
-            exponent: Expr::Num(exponent),
-        },
-        CreepLawSpec::Fastsim { nx, ny } => CreepLawKind::Fastsim { nx, ny },
-        CreepLawSpec::FastsimA { strips, sliding } => CreepLawKind::FastsimA {
-            strips,
-            sliding: match sliding {
-                SlidingZone::Continuation => SlidingZoneKind::Continuation,
-                SlidingZone::Integrated { nodes } => SlidingZoneKind::Integrated { nodes },
-                SlidingZone::Picard { nodes } => SlidingZoneKind::Picard { nodes },
-            },
-        },
-        CreepLawSpec::Polach {
-            ka,
-            ks,
-            friction_decrease,
-        } => CreepLawKind::Polach {
-            ka,
-            ks,
-            friction_decrease,
-        },
-    })
+pub fn parse_creep(
+    text: &str,
+) -> Result<railmbs_models::CreepLawSpec<railmbs_models::Expr>, String> {
+    let spec: railmbs_models::CreepLawSpec = text.parse().map_err(|e| format!("--creep: {e}"))?;
+    Ok(spec.map(|_, &x| railmbs_models::Expr::Num(x)))
 }
 
 /// The measurements of one engine.
@@ -572,7 +549,10 @@ pub fn default_scenario(model_file: &Path) -> Result<Scenario, String> {
 
 /// Replaces the creep law of every wheel–rail element; `false` when the
 /// model has none.
-fn override_creep(model: &mut Model, law: &railmbs_models::CreepLawKind) -> bool {
+fn override_creep(
+    model: &mut Model,
+    law: &railmbs_models::CreepLawSpec<railmbs_models::Expr>,
+) -> bool {
     let mut found = false;
     for f in &mut model.forces {
         if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {

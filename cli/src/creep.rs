@@ -77,7 +77,7 @@ impl Args {
     /// `--sliding` and `--nodes` applied; an error for a flag the law has no
     /// setting for.
     pub fn spec(&self) -> Result<CreepLawSpec, String> {
-        let mut spec = self.method.clone();
+        let mut spec = self.method;
         let not_for = |flag: &str, spec: &CreepLawSpec| {
             format!("--{flag} does not apply to the law {}", spec.name())
         };
@@ -374,44 +374,47 @@ mod tests {
         }
     }
 
-    /// `umsim bench --creep` reads the same text to the same law, defaults
-    /// included.
+    /// `umsim bench --creep` reads the same text to the same law as `umsim
+    /// creep --method`, and the default law is the model files' one.
     #[test]
-    fn bench_reads_the_same_laws() {
-        use railmbs_models::{CreepLawKind, Expr, SlidingZoneKind};
-        let bench = |t: &str| crate::bench::parse_creep(t).unwrap();
-        assert_eq!(
-            bench("mueller"),
-            CreepLawKind::Mueller {
-                exponent: Expr::Num(railmbs_wheelrail::creep::MUELLER_EXPONENT)
-            }
-        );
-        assert_eq!(
-            bench("fastsim-a"),
-            CreepLawKind::FastsimA {
-                strips: railmbs_wheelrail::creep::FASTSIM_A_STRIPS,
-                sliding: SlidingZoneKind::Continuation
-            }
-        );
-        assert_eq!(
-            bench("fastsim:10"),
-            CreepLawKind::Fastsim { nx: 10, ny: 10 }
-        );
-        assert_eq!(
-            bench("fastsim-a-integrated:12"),
-            CreepLawKind::FastsimA {
-                strips: 12,
-                sliding: SlidingZoneKind::Integrated { nodes: 8 }
-            }
-        );
-        assert_eq!(
-            bench("polach:ks=0.5"),
-            CreepLawKind::Polach {
-                ka: 1.0,
-                ks: 0.5,
-                friction_decrease: None
-            }
-        );
+    fn the_three_entry_points_agree() {
+        use railmbs_models::{CreepLawSpec, Expr, ForceKind};
+        let expr = |s: CreepLawSpec| s.map(|_, &x| Expr::Num(x));
+        for text in [
+            "kalker",
+            "mueller",
+            "mueller:3",
+            "fastsim",
+            "fastsim:20",
+            "fastsim-a",
+            "fastsim-a-integrated:12",
+            "fastsim-a:sliding=picard",
+            "polach",
+            "polach:ks=0.5,friction_decrease=0.4/0.6",
+        ] {
+            let creep = spec_of(&["--method", text]).unwrap();
+            assert_eq!(
+                crate::bench::parse_creep(text).unwrap(),
+                expr(creep),
+                "{text}"
+            );
+        }
+        // Every bundled model leaves its wheel–rail law to the default.
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+        let scenario =
+            railmbs_models::load_scenario(&dir.join("scenarios/free_wheelset_klingel.ron"))
+                .unwrap();
+        let model = railmbs_models::load_model(&scenario.model).unwrap();
+        let law = model
+            .forces
+            .iter()
+            .find_map(|f| match &f.kind {
+                ForceKind::WheelRail(w) => Some(w.creep.clone()),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(law, expr(spec_of(&["--method", "fastsim-a"]).unwrap()));
+        assert_eq!(law, crate::bench::parse_creep("fastsim-a").unwrap());
         let e = crate::bench::parse_creep("fastsim:0").unwrap_err();
         assert!(e.starts_with("--creep: creep law \"fastsim:0\""), "{e}");
     }

@@ -73,11 +73,9 @@ use crate::equations::BodyKinematics;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{CreepLawKind, RailKind, SlidingZoneKind, WheelRail};
+use railmbs_models::{RailKind, WheelRail};
 use railmbs_track::{SpeedLaw, Track};
-use railmbs_wheelrail::creep::{
-    ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages, SlidingZone,
-};
+use railmbs_wheelrail::creep::{ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages};
 use railmbs_wheelrail::creepage::ContactFrame;
 use railmbs_wheelrail::elastic_rail::{
     self, ContactMaterial, CreepStart, ElasticRailError, ElasticRailSettings, RailContact,
@@ -154,8 +152,8 @@ struct Constants {
     shear: f64,
     poisson: f64,
     normal_damping: f64,
-    /// Mueller exponent.
-    exponent: f64,
+    /// The creep law, its settings evaluated.
+    creep: CreepLawSpec,
     /// Elastic rails' support (per rail), or `None` for rigid rails.
     rail: Option<RailSupport>,
 }
@@ -1025,33 +1023,6 @@ impl WheelRailContact {
     }
 }
 
-/// The wheelrail crate's spec of a model's creep law, with Mueller's
-/// `exponent` evaluated.
-fn creep_spec(kind: &CreepLawKind, exponent: f64) -> CreepLawSpec {
-    match *kind {
-        CreepLawKind::Kalker => CreepLawSpec::Kalker,
-        CreepLawKind::Mueller { .. } => CreepLawSpec::Mueller { exponent },
-        CreepLawKind::Fastsim { nx, ny } => CreepLawSpec::Fastsim { nx, ny },
-        CreepLawKind::FastsimA { strips, sliding } => CreepLawSpec::FastsimA {
-            strips,
-            sliding: match sliding {
-                SlidingZoneKind::Continuation => SlidingZone::Continuation,
-                SlidingZoneKind::Integrated { nodes } => SlidingZone::Integrated { nodes },
-                SlidingZoneKind::Picard { nodes } => SlidingZone::Picard { nodes },
-            },
-        },
-        CreepLawKind::Polach {
-            ka,
-            ks,
-            friction_decrease,
-        } => CreepLawSpec::Polach {
-            ka,
-            ks,
-            friction_decrease,
-        },
-    }
-}
-
 /// Nadal's limit of Y/Q for flange angle `beta` (rad) and friction `mu`:
 /// (tan β − μ)/(1 + μ tan β) (Nadal 1908).
 pub fn nadal_limit(beta: f64, mu: f64) -> f64 {
@@ -1086,10 +1057,9 @@ impl ForceElement for WheelRailContact {
             shear: young / (2.0 * (1.0 + poisson)),
             poisson,
             normal_damping: ev(&s.normal_damping, "normal_damping")?,
-            exponent: match &s.creep {
-                CreepLawKind::Mueller { exponent } => ev(exponent, "exponent")?,
-                _ => 0.0,
-            },
+            creep: s
+                .creep
+                .try_map(|key, e| eval_scalar(e, params, &name, key))?,
             rail: match &s.rail {
                 RailKind::Rigid => None,
                 RailKind::Elastic { ky, cy, kz, cz } => Some(RailSupport {
@@ -1171,9 +1141,7 @@ impl ForceElement for WheelRailContact {
             ));
         };
         let contact = self.prepare(binding)?;
-        let law = creep_spec(&self.spec.creep, self.c.exponent)
-            .build()
-            .map_err(|e| self.err(e))?;
+        let law = self.c.creep.build().map_err(|e| self.err(e))?;
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
         self.bound = Some(Bound {
             track: binding.track.clone(),

@@ -63,7 +63,7 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// `Mueller`'s exponent, `FastsimA`'s sliding and all of `Polach`'s settings
 /// may be left out (their defaults as above); `Fastsim`'s `nx`, `ny` and
 /// `FastsimA`'s `strips` must be given.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(
     feature = "serde",
