@@ -100,10 +100,13 @@ pub struct Args {
     /// Number of random states the evaluations cycle through.
     #[arg(long, default_value_t = 16)]
     pub states: usize,
-    /// Creep-force law of every wheel–rail element, overriding the model's:
-    /// `fastsim-a[:STRIPS]`, `fastsim-a-integrated[:STRIPS]` (sliding zones
-    /// integrated with 8 nodes), `fastsim:N` (N × N elements), `kalker`,
-    /// `mueller` or `polach`.
+    /// Creep-force law of every wheel–rail element, overriding the model's,
+    /// as `umsim creep --method`: kalker | mueller[:EXPONENT] | fastsim[:N]
+    /// (N × N elements) | fastsim:nx=NX,ny=NY |
+    /// fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] |
+    /// fastsim-a-integrated[:STRIPS] (integrated sliding zones, 8 nodes) |
+    /// polach[:ka=KA,ks=KS,friction_decrease=A/B]. Defaults as in model files
+    /// (FastSim_A 20 strips, FASTSIM 10 × 10, Mueller exponent 2).
     #[arg(long)]
     pub creep: Option<String>,
     /// Build the plugin for any CPU of this architecture instead of this machine's
@@ -112,45 +115,13 @@ pub struct Args {
     pub portable: bool,
 }
 
-/// Parses `--creep`.
-pub fn parse_creep(text: &str) -> Result<railmbs_models::CreepLawKind, String> {
-    use railmbs_models::{CreepLawKind, Expr, SlidingZoneKind};
-    let (name, n) = match text.split_once(':') {
-        Some((a, b)) => (
-            a,
-            Some(b.parse::<usize>().ok().filter(|&n| n > 0).ok_or_else(|| {
-                format!("--creep {text}: \"{b}\" is not a positive number of strips/elements")
-            })?),
-        ),
-        None => (text, None),
-    };
-    match (name, n) {
-        ("fastsim-a", n) => Ok(CreepLawKind::FastsimA {
-            strips: n.unwrap_or(20),
-            sliding: SlidingZoneKind::Continuation,
-        }),
-        ("fastsim-a-integrated", n) => Ok(CreepLawKind::FastsimA {
-            strips: n.unwrap_or(20),
-            sliding: SlidingZoneKind::Integrated { nodes: 8 },
-        }),
-        ("polach", None) => Ok(CreepLawKind::Polach {
-            ka: 1.0,
-            ks: 1.0,
-            friction_decrease: None,
-        }),
-        ("fastsim", n) => {
-            let n = n.unwrap_or(10);
-            Ok(CreepLawKind::Fastsim { nx: n, ny: n })
-        }
-        ("kalker", None) => Ok(CreepLawKind::Kalker),
-        ("mueller", None) => Ok(CreepLawKind::Mueller {
-            exponent: Expr::Num(2.0),
-        }),
-        _ => Err(format!(
-            "--creep {text}: expected fastsim-a[:STRIPS], fastsim-a-integrated[:STRIPS], \
-             fastsim[:N], kalker, mueller or polach"
-        )),
-    }
+/// Parses `--creep`: a creep law in the syntax of
+/// [`railmbs_wheelrail::creep::CreepLawSpec`] (as `umsim creep --method`).
+pub fn parse_creep(
+    text: &str,
+) -> Result<railmbs_models::CreepLawSpec<railmbs_models::Expr>, String> {
+    let spec: railmbs_models::CreepLawSpec = text.parse().map_err(|e| format!("--creep: {e}"))?;
+    Ok(spec.map(|_, &x| railmbs_models::Expr::Num(x)))
 }
 
 /// The measurements of one engine.
@@ -550,7 +521,10 @@ pub fn default_scenario(model_file: &Path) -> Result<Scenario, String> {
 
 /// Replaces the creep law of every wheel–rail element; `false` when the
 /// model has none.
-fn override_creep(model: &mut Model, law: &railmbs_models::CreepLawKind) -> bool {
+fn override_creep(
+    model: &mut Model,
+    law: &railmbs_models::CreepLawSpec<railmbs_models::Expr>,
+) -> bool {
     let mut found = false;
     for f in &mut model.forces {
         if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {

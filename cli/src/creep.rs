@@ -1,15 +1,18 @@
 //! `umsim creep`: creep forces for a table of contact cases.
 //!
 //! ```text
-//! umsim creep --method kalker|mueller|fastsim|fastsim-a|polach [--strips M] [--elements N] \
-//!             [--sliding continuation|integrated|picard] [--nodes K] --cases FILE.csv [-o out.csv]
+//! umsim creep --method LAW --cases FILE.csv [-o out.csv]
 //! ```
 //!
-//! `--sliding` selects FastSim_A's treatment of the sliding zones (default
-//! `continuation`; `integrated` is more accurate at large spin, about ten times
-//! slower; see `railmbs_wheelrail::creep::SlidingZone`), with `--nodes` Gauss
-//! nodes per zone (default 8). `polach` is Polach's 1999 law (constant
-//! friction, no reduction factors).
+//! `LAW` is a creep law in the syntax of `umsim bench --creep` and of
+//! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]`,
+//! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
+//! `,sliding=continuation|integrated|picard` and `,nodes=K`,
+//! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`;
+//! defaults as in model files. FastSim_A's `integrated` sliding zones are more
+//! accurate at large spin, about ten times slower (see
+//! `railmbs_wheelrail::creep::SlidingZone`). The older flags `--strips`,
+//! `--elements`, `--sliding` and `--nodes` still set those settings of the law.
 //!
 //! Input columns (any order, by header name): `a,b,G,nu,mu,N,xi,eta,phi` in
 //! m, m, Pa, –, –, N, –, –, 1/m. Output columns `Fx,Fy,Mz` in N, N, N·m: forces
@@ -18,28 +21,12 @@
 //! row number, 1-based, and file line) and the column.
 
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller, Polach,
-    SlidingZone,
+    ContactPatch, CreepLaw, CreepLawSpec, Creepages, INTEGRATED_NODES, SlidingZone,
 };
 use std::io::{Read, Write};
 use std::path::PathBuf;
 
-/// Creep-force law to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
-    /// Kalker's linear theory.
-    Kalker,
-    /// Kalker's linear force saturated towards μN (exponent 3).
-    Mueller,
-    /// Kalker's FASTSIM, strips × elements, parabolic traction bound.
-    Fastsim,
-    /// Semi-analytic FastSim_A, strips only.
-    FastsimA,
-    /// Polach's method (1999; spin included).
-    Polach,
-}
-
-/// FastSim_A's treatment of the sliding zones.
+/// FastSim_A's treatment of the sliding zones (`--sliding`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Sliding {
     /// Adhesion-continuation direction in closed form (fastest).
@@ -53,21 +40,28 @@ pub enum Sliding {
 /// Arguments of `umsim creep`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Creep-force law.
+    /// Creep-force law and its settings: kalker | mueller[:EXPONENT] |
+    /// fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY |
+    /// fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] |
+    /// fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B].
+    /// Defaults: Mueller exponent 2, FASTSIM 10 × 10, FastSim_A 20 strips with
+    /// continuation sliding (8 Gauss nodes for integrated/picard), Polach
+    /// ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated
+    #[arg(long, visible_alias = "law", value_name = "LAW")]
+    pub method: CreepLawSpec,
+    /// Number of strips (FASTSIM, FastSim_A): overrides the law's.
+    #[arg(long)]
+    pub strips: Option<usize>,
+    /// Number of elements per strip (FASTSIM): overrides the law's nx.
+    #[arg(long)]
+    pub elements: Option<usize>,
+    /// FastSim_A's treatment of the sliding zones: overrides the law's.
     #[arg(long, value_enum)]
-    pub method: Method,
-    /// Number of strips (FASTSIM, FastSim_A).
-    #[arg(long, default_value_t = 10)]
-    pub strips: usize,
-    /// Number of elements per strip (FASTSIM).
-    #[arg(long, default_value_t = 10)]
-    pub elements: usize,
-    /// FastSim_A's treatment of the sliding zones.
-    #[arg(long, value_enum, default_value_t = Sliding::Continuation)]
-    pub sliding: Sliding,
-    /// Gauss nodes per sliding zone (FastSim_A with `--sliding integrated|picard`).
-    #[arg(long, default_value_t = railmbs_wheelrail::creep::INTEGRATED_NODES)]
-    pub nodes: usize,
+    pub sliding: Option<Sliding>,
+    /// Gauss nodes per sliding zone (FastSim_A, integrated or picard):
+    /// overrides the law's.
+    #[arg(long)]
+    pub nodes: Option<usize>,
     /// Input CSV with columns a,b,G,nu,mu,N,xi,eta,phi.
     #[arg(long)]
     pub cases: PathBuf,
@@ -78,40 +72,58 @@ pub struct Args {
 
 const COLUMNS: [&str; 9] = ["a", "b", "G", "nu", "mu", "N", "xi", "eta", "phi"];
 
-/// Builds the law for the arguments (FastSim_A with the continuation
-/// direction).
-pub fn law(method: Method, strips: usize, elements: usize) -> Result<Box<dyn CreepLaw>, String> {
-    law_with_sliding(method, strips, elements, Sliding::Continuation, 0)
-}
-
-/// Builds the law for the arguments, FastSim_A with the given sliding-zone
-/// treatment and Gauss nodes per zone.
-pub fn law_with_sliding(
-    method: Method,
-    strips: usize,
-    elements: usize,
-    sliding: Sliding,
-    nodes: usize,
-) -> Result<Box<dyn CreepLaw>, String> {
-    let err = |e: railmbs_wheelrail::creep::CreepError| e.to_string();
-    Ok(match method {
-        Method::Kalker => Box::new(KalkerLinear),
-        Method::Mueller => Box::new(Mueller::default()),
-        Method::Fastsim => Box::new(Fastsim::new(strips, elements).map_err(err)?),
-        Method::FastsimA => {
-            let zone = match sliding {
+impl Args {
+    /// The law of `--method` with the settings of `--strips`, `--elements`,
+    /// `--sliding` and `--nodes` applied; an error for a flag the law has no
+    /// setting for.
+    pub fn spec(&self) -> Result<CreepLawSpec, String> {
+        let mut spec = self.method;
+        let not_for = |flag: &str, spec: &CreepLawSpec| {
+            format!("--{flag} does not apply to the law {}", spec.name())
+        };
+        if let Some(n) = self.strips {
+            match &mut spec {
+                CreepLawSpec::Fastsim { ny, .. } => *ny = n,
+                CreepLawSpec::FastsimA { strips, .. } => *strips = n,
+                other => return Err(not_for("strips", other)),
+            }
+        }
+        if let Some(n) = self.elements {
+            match &mut spec {
+                CreepLawSpec::Fastsim { nx, .. } => *nx = n,
+                other => return Err(not_for("elements", other)),
+            }
+        }
+        if let Some(s) = self.sliding {
+            let CreepLawSpec::FastsimA { sliding, .. } = &mut spec else {
+                return Err(not_for("sliding", &spec));
+            };
+            let nodes = match *sliding {
+                SlidingZone::Integrated { nodes } | SlidingZone::Picard { nodes } => nodes,
+                SlidingZone::Continuation => INTEGRATED_NODES,
+            };
+            *sliding = match s {
                 Sliding::Continuation => SlidingZone::Continuation,
                 Sliding::Integrated => SlidingZone::Integrated { nodes },
                 Sliding::Picard => SlidingZone::Picard { nodes },
             };
-            Box::new(
-                FastsimA::new(strips)
-                    .and_then(|l| l.with_sliding(zone))
-                    .map_err(err)?,
-            )
         }
-        Method::Polach => Box::new(Polach::new()),
-    })
+        if let Some(n) = self.nodes {
+            match &mut spec {
+                CreepLawSpec::FastsimA {
+                    sliding: SlidingZone::Integrated { nodes } | SlidingZone::Picard { nodes },
+                    ..
+                } => *nodes = n,
+                other => {
+                    return Err(format!(
+                        "--nodes applies to FastSim_A with integrated or picard sliding zones, \
+                         not to {other}"
+                    ));
+                }
+            }
+        }
+        Ok(spec)
+    }
 }
 
 /// Evaluates every case of the CSV in `input` with `law` and writes `Fx,Fy,Mz`
@@ -190,13 +202,7 @@ pub fn evaluate<R: Read, W: Write>(
 
 /// Runs `umsim creep`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let law = law_with_sliding(
-        args.method,
-        args.strips,
-        args.elements,
-        args.sliding,
-        args.nodes,
-    )?;
+    let law = args.spec()?.build()?;
     let source = args.cases.display().to_string();
     let file = std::fs::File::open(&args.cases).map_err(|e| format!("{source}: {e}"))?;
     match &args.output {
@@ -216,8 +222,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 mod tests {
     use super::*;
 
-    fn run_str(method: Method, input: &str) -> Result<String, String> {
-        let law = law(method, 10, 10)?;
+    fn run_str(law: &str, input: &str) -> Result<String, String> {
+        let law = law
+            .parse::<CreepLawSpec>()
+            .map_err(|e| e.to_string())?
+            .build()
+            .map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         evaluate(law.as_ref(), input.as_bytes(), "cases.csv", &mut out)?;
         Ok(String::from_utf8(out).unwrap())
@@ -228,13 +238,7 @@ mod tests {
         let input = "xi,eta,phi,a,b,G,nu,mu,N\n\
                      0.001,0,0,0.006,0.004,8e10,0.28,0.3,80000\n\
                      0,0,0,0.006,0.004,8e10,0.28,0.3,80000\n";
-        for m in [
-            Method::Kalker,
-            Method::Mueller,
-            Method::Fastsim,
-            Method::FastsimA,
-            Method::Polach,
-        ] {
+        for m in ["kalker", "mueller", "fastsim:10", "fastsim-a:10", "polach"] {
             let out = run_str(m, input).unwrap();
             let lines: Vec<&str> = out.lines().collect();
             assert_eq!(lines[0], "Fx,Fy,Mz");
@@ -245,7 +249,7 @@ mod tests {
         }
         // Kalker linear: Fx = −G a b C11 ξ, C11(a/b = 1.5, ν = 0.28) interpolated
         // in Kalker's table between b/a = 0.7 and 0.6 (4.587, 4.813 at ν = 0.28).
-        let out = run_str(Method::Kalker, input).unwrap();
+        let out = run_str("kalker", input).unwrap();
         let fx: f64 = out
             .lines()
             .nth(1)
@@ -264,24 +268,154 @@ mod tests {
 
     #[test]
     fn bad_rows_are_named() {
-        let e = run_str(
-            Method::Kalker,
-            "a,b,G,nu,mu,N,xi,eta\n1,1,1,0.3,0.3,1,0,0\n",
-        )
-        .unwrap_err();
+        let e = run_str("kalker", "a,b,G,nu,mu,N,xi,eta\n1,1,1,0.3,0.3,1,0,0\n").unwrap_err();
         assert!(e.contains("missing column 'phi'"), "{e}");
         let e = run_str(
-            Method::Fastsim,
+            "fastsim",
             "a,b,G,nu,mu,N,xi,eta,phi\n0.006,0.004,8e10,0.28,0.3,80000,0,0,0\n0.006,x,8e10,0.28,0.3,80000,0,0,0\n",
         )
         .unwrap_err();
         assert!(e.contains("row 2") && e.contains("column 'b'"), "{e}");
         let e = run_str(
-            Method::FastsimA,
+            "fastsim-a",
             "a,b,G,nu,mu,N,xi,eta,phi\n0.006,0.004,8e10,0.9,0.3,80000,0,0,0\n",
         )
         .unwrap_err();
         assert!(e.contains("row 1") && e.contains("nu = 0.9"), "{e}");
-        assert!(law(Method::Fastsim, 0, 10).is_err());
+        assert!(
+            run_str("fastsim:0", "")
+                .unwrap_err()
+                .contains("positive whole number")
+        );
+    }
+
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn spec_of(args: &[&str]) -> Result<CreepLawSpec, String> {
+        use clap::Parser;
+        let cli = Cli::try_parse_from(
+            ["creep", "--cases", "c.csv"]
+                .iter()
+                .chain(args.iter())
+                .copied(),
+        )
+        .map_err(|e| e.to_string())?;
+        cli.args.spec()
+    }
+
+    #[test]
+    fn the_law_and_the_older_flags() {
+        let spec = |a: &[&str]| spec_of(a).unwrap();
+        // The defaults are the spec's, as for model files and umsim bench.
+        assert_eq!(spec(&["--method", "fastsim-a"]), CreepLawSpec::default());
+        assert_eq!(spec(&["--method", "mueller"]), CreepLawSpec::mueller());
+        assert_eq!(spec(&["--law", "fastsim"]), CreepLawSpec::fastsim());
+        assert_eq!(
+            spec(&["--method", "fastsim", "--strips", "20", "--elements", "30"]),
+            CreepLawSpec::Fastsim { nx: 30, ny: 20 }
+        );
+        assert_eq!(
+            spec(&[
+                "--method",
+                "fastsim-a",
+                "--sliding",
+                "picard",
+                "--nodes",
+                "4"
+            ]),
+            "fastsim-a:sliding=picard,nodes=4".parse().unwrap()
+        );
+        assert_eq!(
+            spec(&[
+                "--method",
+                "fastsim-a:strips=5,sliding=integrated,nodes=3",
+                "--strips",
+                "7"
+            ]),
+            "fastsim-a:7,sliding=integrated,nodes=3".parse().unwrap()
+        );
+        assert_eq!(
+            spec(&[
+                "--method",
+                "fastsim-a-integrated:12",
+                "--sliding",
+                "continuation"
+            ]),
+            "fastsim-a:12".parse().unwrap()
+        );
+        for (args, expected) in [
+            (
+                &["--method", "kalker", "--strips", "3"][..],
+                "--strips does not apply to the law kalker",
+            ),
+            (
+                &["--method", "polach", "--sliding", "picard"],
+                "--sliding does not apply",
+            ),
+            (
+                &["--method", "fastsim-a", "--elements", "3"],
+                "--elements does not apply",
+            ),
+            (
+                &["--method", "fastsim-a", "--nodes", "3"],
+                "--nodes applies to FastSim_A with",
+            ),
+            (
+                &["--method", "fastsim:nx=0"],
+                "nx: \"0\" is not a positive whole number",
+            ),
+        ] {
+            let e = spec_of(args).unwrap_err();
+            assert!(e.contains(expected), "{args:?}: {e}");
+        }
+    }
+
+    /// `umsim bench --creep` reads the same text to the same law as `umsim
+    /// creep --method`, and the default law is the model files' one.
+    #[test]
+    fn the_three_entry_points_agree() {
+        use railmbs_models::{CreepLawSpec, Expr, ForceKind};
+        let expr = |s: CreepLawSpec| s.map(|_, &x| Expr::Num(x));
+        for text in [
+            "kalker",
+            "mueller",
+            "mueller:3",
+            "fastsim",
+            "fastsim:20",
+            "fastsim-a",
+            "fastsim-a-integrated:12",
+            "fastsim-a:sliding=picard",
+            "polach",
+            "polach:ks=0.5,friction_decrease=0.4/0.6",
+        ] {
+            let creep = spec_of(&["--method", text]).unwrap();
+            assert_eq!(
+                crate::bench::parse_creep(text).unwrap(),
+                expr(creep),
+                "{text}"
+            );
+        }
+        // Every bundled model leaves its wheel–rail law to the default.
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+        let scenario =
+            railmbs_models::load_scenario(&dir.join("scenarios/free_wheelset_klingel.ron"))
+                .unwrap();
+        let model = railmbs_models::load_model(&scenario.model).unwrap();
+        let law = model
+            .forces
+            .iter()
+            .find_map(|f| match &f.kind {
+                ForceKind::WheelRail(w) => Some(w.creep.clone()),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(law, expr(spec_of(&["--method", "fastsim-a"]).unwrap()));
+        assert_eq!(law, crate::bench::parse_creep("fastsim-a").unwrap());
+        let e = crate::bench::parse_creep("fastsim:0").unwrap_err();
+        assert!(e.starts_with("--creep: creep law \"fastsim:0\""), "{e}");
     }
 }

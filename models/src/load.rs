@@ -2248,7 +2248,7 @@ struct WheelRailRaw<'r> {
     /// poisson, normal_damping.
     values: [(&'static str, &'r Value); 7],
     rail_profile_inclined: bool,
-    creep: &'r RawCreepLaw,
+    creep: &'r CreepLawSpec<Value>,
     rail: &'r RawRail,
     table: &'r RawTable,
     /// Independently rotating wheels' bodies (left, right), if any.
@@ -2321,83 +2321,20 @@ impl Cx<'_> {
                 );
             }
         }
-        let creep = match raw.creep {
-            RawCreepLaw::Kalker => CreepLawKind::Kalker,
-            RawCreepLaw::Mueller { exponent } => {
-                let exponent = self.expr(w, "creep.exponent", "exponent", exponent, false);
-                self.check_positive(w, "exponent", &exponent);
-                CreepLawKind::Mueller { exponent }
-            }
-            RawCreepLaw::Fastsim { nx, ny } => {
-                if *nx == 0 || *ny == 0 {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!("FASTSIM needs at least one element each way, got {nx} × {ny}"),
-                    );
-                }
-                CreepLawKind::Fastsim { nx: *nx, ny: *ny }
-            }
-            RawCreepLaw::FastsimA { strips, sliding } => {
-                if *strips == 0 {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        "FastSim_A needs at least one strip".into(),
-                    );
-                }
-                if let SlidingZoneKind::Integrated { nodes } | SlidingZoneKind::Picard { nodes } =
-                    sliding
-                    && !(1..=32).contains(nodes)
-                {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!("FastSim_A sliding-zone nodes must be in 1..=32, got {nodes}"),
-                    );
-                }
-                CreepLawKind::FastsimA {
-                    strips: *strips,
-                    sliding: *sliding,
-                }
-            }
-            RawCreepLaw::Polach {
-                ka,
-                ks,
-                friction_decrease,
-            } => {
-                for (key, v) in [("ka", ka), ("ks", ks)] {
-                    if !(*v > 0.0 && *v <= 1.0) {
-                        self.err(
-                            w,
-                            Some("creep"),
-                            None,
-                            format!("Polach {key} must be in (0, 1], got {v}"),
-                        );
-                    }
-                }
-                if let Some((a, b)) = friction_decrease
-                    && !(*a >= 0.0 && a.is_finite() && *b >= 0.0 && b.is_finite())
-                {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!(
-                            "Polach friction_decrease (A, B) needs A ≥ 0 and B ≥ 0 s/m, got ({a}, {b})"
-                        ),
-                    );
-                }
-                CreepLawKind::Polach {
-                    ka: *ka,
-                    ks: *ks,
-                    friction_decrease: *friction_decrease,
-                }
-            }
-        };
+        let creep = raw
+            .creep
+            .map(|key, v| self.expr(w, &format!("creep.{key}"), key, v, false));
+        // The law's own checks, settings at the default parameters (1 where
+        // unknown or not finite: counts are checked all the same).
+        let d = self.defaults.as_deref();
+        let at_defaults = creep.map(|_, e| {
+            d.map(|d| e.eval(d, 0.0))
+                .filter(|x| x.is_finite())
+                .unwrap_or(1.0)
+        });
+        if let Err(e) = at_defaults.validate() {
+            self.err(w, Some("creep"), None, e.to_string());
+        }
         let rail = match raw.rail {
             RawRail::Rigid => RailKind::Rigid,
             RawRail::Elastic { ky, cy, kz, cz } => {

@@ -355,7 +355,7 @@ pub struct WheelRail {
     /// Damping along the contact normal, N s/m (0: none).
     pub normal_damping: Expr,
     /// The creep-force law.
-    pub creep: CreepLawKind,
+    pub creep: CreepLawSpec<Expr>,
     /// Rigid rails, or massless elastic rails (seed paper Sect. 4.2).
     pub rail: RailKind,
     /// Contact table ranges and steps.
@@ -369,42 +369,9 @@ pub struct WheelRail {
     pub wheels: Option<[usize; 2]>,
 }
 
-/// Creep-force law of a wheel–rail element.
-#[derive(Debug, Clone, PartialEq)]
-pub enum CreepLawKind {
-    /// Kalker's linear theory (no saturation).
-    Kalker,
-    /// Linear theory saturated towards μN (exponent n, Mueller et al.).
-    Mueller { exponent: Expr },
-    /// Kalker's FASTSIM with `nx` × `ny` elements.
-    Fastsim { nx: usize, ny: usize },
-    /// Pogorelov's semi-analytic FastSim_A with `strips` strips and the
-    /// chosen treatment of the sliding zones.
-    FastsimA {
-        strips: usize,
-        sliding: SlidingZoneKind,
-    },
-    /// Polach's law (1999), with the 2005 reduction factors k_A, k_S in (0, 1]
-    /// and optionally the friction decrease μ = μ0[(1 − A)e^(−B w) + A] with
-    /// (A, B s/m), w the slip velocity at the wheelset's rolling speed.
-    Polach {
-        ka: f64,
-        ks: f64,
-        friction_decrease: Option<(f64, f64)>,
-    },
-}
-
-/// FastSim_A's sliding zones (`railmbs_wheelrail::creep::SlidingZone`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
-pub enum SlidingZoneKind {
-    /// The adhesion-continuation direction in closed form (fastest).
-    #[default]
-    Continuation,
-    /// Integrated node to node with re-adhesion (accurate at flange spin).
-    Integrated { nodes: usize },
-    /// One Picard step of the direction ODE (for comparison).
-    Picard { nodes: usize },
-}
+/// Creep-force law of a wheel–rail element: the wheelrail crate's spec, its
+/// real-valued settings as expressions over the parameters.
+pub use railmbs_wheelrail::creep::{CreepLawSpec, SlidingZone};
 
 /// The rails of a wheel–rail element.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,7 +1,7 @@
 //! The RON syntax of model files as serde types, before resolution: names are
 //! still strings and numeric fields are numbers or expression text.
 
-use crate::model::{Axis, Interpolation, SlidingZoneKind};
+use crate::model::{Axis, CreepLawSpec, Interpolation};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, de::IgnoredAny};
 use std::fmt;
@@ -16,6 +16,13 @@ pub(crate) enum Value {
 impl Default for Value {
     fn default() -> Self {
         Value::Num(0.0)
+    }
+}
+
+/// A number (the defaults of `CreepLawSpec`'s settings).
+impl From<f64> for Value {
+    fn from(x: f64) -> Self {
+        Value::Num(x)
     }
 }
 
@@ -594,7 +601,7 @@ pub(crate) enum RawForce {
         #[serde(default)]
         normal_damping: Value,
         #[serde(default)]
-        creep: RawCreepLaw,
+        creep: CreepLawSpec<Value>,
         #[serde(default)]
         rail: RawRail,
         #[serde(default)]
@@ -652,55 +659,6 @@ fn default_young() -> Value {
 
 fn default_poisson() -> Value {
     Value::Num(0.28)
-}
-
-/// Creep-force law of a `WheelRail` element.
-#[derive(Debug, Deserialize)]
-#[serde(rename = "CreepLaw")]
-pub(crate) enum RawCreepLaw {
-    Kalker,
-    Mueller {
-        #[serde(default = "default_mueller_exponent")]
-        exponent: Value,
-    },
-    Fastsim {
-        nx: usize,
-        ny: usize,
-    },
-    FastsimA {
-        strips: usize,
-        #[serde(default)]
-        sliding: SlidingZoneKind,
-    },
-    Polach {
-        #[serde(default = "one")]
-        ka: f64,
-        #[serde(default = "one")]
-        ks: f64,
-        #[serde(default, deserialize_with = "some_pair")]
-        friction_decrease: Option<(f64, f64)>,
-    },
-}
-
-fn one() -> f64 {
-    1.0
-}
-
-fn some_pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(f64, f64)>, D::Error> {
-    <(f64, f64)>::deserialize(d).map(Some)
-}
-
-impl Default for RawCreepLaw {
-    fn default() -> Self {
-        RawCreepLaw::FastsimA {
-            strips: 20,
-            sliding: SlidingZoneKind::Continuation,
-        }
-    }
-}
-
-fn default_mueller_exponent() -> Value {
-    Value::Num(2.0)
 }
 
 /// Rails of a `WheelRail` element.

@@ -175,13 +175,7 @@ impl ForceKind {
                 ] {
                     f(e);
                 }
-                match creep {
-                    CreepLawKind::Mueller { exponent } => f(exponent),
-                    CreepLawKind::Kalker
-                    | CreepLawKind::Fastsim { .. }
-                    | CreepLawKind::FastsimA { .. }
-                    | CreepLawKind::Polach { .. } => {}
-                }
+                creep.for_each_value_mut(|_, e| f(e));
                 match rail {
                     RailKind::Elastic { ky, cy, kz, cz } => {
                         for e in [ky, cy, kz, cz] {

@@ -35,21 +35,21 @@ fn free_wheelset_runs_klingels_kinematic_oscillation() {
 /// model language.
 #[test]
 fn klingel_holds_for_polach_and_integrated_fastsim_a() {
-    use railmbs_models::{CreepLawKind, SlidingZoneKind};
-    klingel_check(Some(CreepLawKind::Polach {
-        ka: 1.0,
-        ks: 1.0,
+    use railmbs_models::{CreepLawSpec, Expr, SlidingZone};
+    klingel_check(Some(CreepLawSpec::Polach {
+        ka: Expr::Num(1.0),
+        ks: Expr::Num(1.0),
         friction_decrease: None,
     }));
-    klingel_check(Some(CreepLawKind::FastsimA {
+    klingel_check(Some(CreepLawSpec::FastsimA {
         strips: 10,
-        sliding: SlidingZoneKind::Integrated { nodes: 8 },
+        sliding: SlidingZone::Integrated { nodes: 8 },
     }));
 }
 
 /// Runs the Klingel scenario (with the wheel–rail creep law replaced by
 /// `law`) and checks the wavelength.
-fn klingel_check(law: Option<railmbs_models::CreepLawKind>) {
+fn klingel_check(law: Option<railmbs_models::CreepLawSpec<railmbs_models::Expr>>) {
     let speed = 10.0;
     let scenario =
         railmbs_models::load_scenario(&model_path("scenarios/free_wheelset_klingel.ron")).unwrap();

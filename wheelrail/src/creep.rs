@@ -13,18 +13,25 @@
 //!   [`crate::kalker`];
 //! - [`Mueller`]: the linear force saturated towards `μN`;
 //! - [`Fastsim`]: Kalker's FASTSIM algorithm (simplified theory);
-//! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (seed paper Sect. 4.3):
+//! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (Pogorelov 2005, Sect. 4.3):
 //!   closed-form strips, cost proportional to the number of strips only;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
 //!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
+//!
+//! [`CreepLawSpec`] names a law and its settings (model files, command line)
+//! and builds it.
 
 mod fastsim;
 mod fastsim_a;
 mod polach;
+mod spec;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
 pub use polach::Polach;
+pub use spec::{
+    CREEP_LAW_SYNTAX, CreepLawSpec, FASTSIM_A_STRIPS, FASTSIM_DIVISIONS, ParseCreepLawError,
+};
 
 pub use crate::creepage::Creepages;
 use crate::kalker::KalkerCoefficients;
@@ -198,19 +205,28 @@ impl CreepLaw for KalkerLinear {
 /// Mueller-type saturation of Kalker's linear forces: with the linear tangential
 /// force `F_lin = |(Fx, Fy)|` and `u = F_lin/(μN)`, all of `Fx, Fy, Mz` are
 /// scaled by `1/(1 + uⁿ)^(1/n)`, so the force follows the linear theory at small
-/// creepage and tends to `μN` at large creepage. The exponent `n` (default 3)
-/// sets the sharpness of the transition.
+/// creepage and tends to `μN` at large creepage. The exponent `n` (default
+/// [`MUELLER_EXPONENT`] = 2) sets the sharpness of the transition.
 ///
-/// Note: the seed paper's Sect. 4.2 text of this law could not be retrieved with
-/// the project's search tool; this is the saturation form as commonly stated.
+/// This is not the law Pogorelov 2005, Sect. 4.2 calls Mueller's method: that
+/// one saturates the same way (exponent `m`) but from an empirical,
+/// load-dependent slope `k_c(P) = P(235 + P(2.4 − 0.01P))`, `P = 0.001 N`,
+/// independent of the contact ellipse and of spin, with the flange contact as
+/// pure sliding. Here the slope is Kalker's linear theory, spin included.
 #[derive(Debug, Clone, Copy)]
 pub struct Mueller {
     exponent: f64,
 }
 
+/// Default exponent `n` of [`Mueller`], –: used by model files, `umsim creep`
+/// and `umsim bench --creep` alike.
+pub const MUELLER_EXPONENT: f64 = 2.0;
+
 impl Default for Mueller {
     fn default() -> Self {
-        Self { exponent: 3.0 }
+        Self {
+            exponent: MUELLER_EXPONENT,
+        }
     }
 }
 

@@ -147,11 +147,10 @@ impl Creepages {
             omega_wheel[1] - omega_rail[1],
             omega_wheel[2] - omega_rail[2],
         ];
-        let inv = 1.0 / v_roll;
         Ok(Self {
-            xi: dot(dv, frame.ex) * inv,
-            eta: dot(dv, frame.ey) * inv,
-            phi: dot(dw, frame.n) * inv,
+            xi: dot(dv, frame.ex) / v_roll,
+            eta: dot(dv, frame.ey) / v_roll,
+            phi: dot(dw, frame.n) / v_roll,
         })
     }
 }

@@ -1,4 +1,4 @@
-//! Massless elastic rail (seed paper Sect. 4.2): the rail head of one rail is a
+//! Massless elastic rail (Pogorelov 2005, Sect. 4.2): the rail head of one rail is a
 //! massless body that moves laterally and vertically against springs and
 //! dampers to ground, and is in quasi-static equilibrium with the wheel–rail
 //! contact forces at every instant.

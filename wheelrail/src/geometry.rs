@@ -1,4 +1,4 @@
-//! Contact geometry of a wheelset on a track (seed paper, Sect. 4.1).
+//! Contact geometry of a wheelset on a track (Pogorelov 2005, Sect. 4.1).
 //!
 //! # Frames and conventions
 //!

@@ -1,7 +1,7 @@
 //! # railmbs-wheelrail
 //!
 //! Wheel–rail contact as pure functions, validated against published references
-//! (seed paper Sect. 4; reference data in `../shared/reference`):
+//! (Pogorelov 2005, Sect. 4; reference data in `../shared/reference`):
 //!
 //! - [`profile`]: wheel and rail profiles (SIMPACK `.prw`/`.prr`, MiniProf
 //!   `.whl`/`.ban`, two-column y–z), orientation, smoothing, evaluation;

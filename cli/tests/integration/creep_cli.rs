@@ -55,6 +55,12 @@ fn every_method_reproduces_linear_theory_and_saturation() {
             0.02,
         ),
         (vec!["--method", "fastsim-a", "--strips", "20"], 0.02),
+        (vec!["--method", "fastsim:20"], 0.02),
+        (
+            vec!["--law", "fastsim-a:strips=20,sliding=integrated,nodes=8"],
+            0.02,
+        ),
+        (vec!["--method", "mueller:3"], 1e-6),
         (
             vec![
                 "--method",
@@ -112,4 +118,23 @@ fn bad_input_is_named() {
     );
     assert!(!ok);
     assert!(err.contains("nodes"), "{err}");
+}
+
+#[test]
+fn bad_law_is_named_and_help_gives_the_syntax() {
+    let (ok, _, err) = run(&["--method", "fastsim-a:sliding=exact"], CASES);
+    assert!(!ok);
+    assert!(
+        err.contains("\"exact\" is not continuation, integrated or picard"),
+        "{err}"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_umsim"))
+        .args(["creep", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        help.contains("fastsim-a[:STRIPS]") && help.contains("polach[:ka="),
+        "{help}"
+    );
 }

@@ -444,8 +444,11 @@ pub(super) fn force_value_problems(kind: &ForceKind, d: &[f64]) -> Vec<String> {
             if nu.is_finite() && !(0.0..=0.5).contains(&nu) {
                 out.push(format!("poisson must be in [0, 0.5], got {nu}"));
             }
-            if let CreepLawKind::Mueller { exponent } = &w.creep {
-                positive(&mut out, "exponent", exponent);
+            let creep = w
+                .creep
+                .map(|_, e| Some(v(e)).filter(|x| x.is_finite()).unwrap_or(1.0));
+            if let Err(e) = creep.validate() {
+                out.push(e.to_string());
             }
             if let RailKind::Elastic { ky, cy, kz, cz } = &w.rail {
                 positive(&mut out, "ky", ky);

@@ -291,3 +291,83 @@ fn load_model_reads_a_file() {
     assert!(missing.to_string().contains("missing.ron"), "{missing}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `free_wheelset.ron` with `creep` set to `law` (profiles by absolute path).
+fn wheelset_with_creep(law: &str) -> Result<Model, ModelErrors> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(dir.join("vehicles/free_wheelset.ron")).unwrap();
+    let profiles = dir.join("profiles").display().to_string();
+    let text = text
+        .replace("\"../profiles", &format!("\"{profiles}"))
+        .replace(
+            "normal_damping: \"cn\",",
+            &format!("normal_damping: \"cn\", creep: {law},"),
+        );
+    let path = std::env::temp_dir().join(format!(
+        "railmbs-creep-law-{}-{}.ron",
+        std::process::id(),
+        law.len()
+    ));
+    std::fs::write(&path, text).unwrap();
+    let model = load_model(&path);
+    std::fs::remove_file(&path).unwrap();
+    model
+}
+
+/// The creep law of a wheel–rail element is wheelrail's `CreepLawSpec`, its
+/// real-valued settings expressions over the parameters, checked by the law's
+/// own rules at the default parameters.
+#[test]
+fn wheel_rail_creep_law_settings_are_expressions() {
+    let creep = |m: &Model| {
+        m.forces
+            .iter()
+            .find_map(|f| match &f.kind {
+                ForceKind::WheelRail(w) => Some(w.creep.clone()),
+                _ => None,
+            })
+            .unwrap()
+    };
+    let m = wheelset_with_creep("Mueller(exponent: \"2*mu + 1\")").unwrap();
+    let defaults: Vec<f64> = m
+        .parameters
+        .iter()
+        .map(|p| p.default.eval(&[], 0.0))
+        .collect();
+    assert_eq!(
+        creep(&m).map(|_, e| e.eval(&defaults, 0.0)),
+        CreepLawSpec::Mueller { exponent: 1.8 }
+    );
+    let m = wheelset_with_creep("Polach(ks: 0.5, friction_decrease: (\"mu\", 0.6))").unwrap();
+    assert_eq!(
+        creep(&m).map(|_, e| e.eval(&defaults, 0.0)),
+        CreepLawSpec::Polach {
+            ka: 1.0,
+            ks: 0.5,
+            friction_decrease: Some((0.4, 0.6))
+        }
+    );
+    let m = wheelset_with_creep("FastsimA(strips: 7, sliding: Picard(nodes: 3))").unwrap();
+    assert_eq!(
+        creep(&m),
+        "fastsim-a:7,sliding=picard,nodes=3"
+            .parse::<CreepLawSpec>()
+            .unwrap()
+            .map(|_, &x| Expr::Num(x))
+    );
+    for (law, expected) in [
+        (
+            "FastsimA(strips: 0)",
+            "FastSim_A number of strips must be in 1..=",
+        ),
+        (
+            "Mueller(exponent: \"mu - 1\")",
+            "Mueller exponent must be positive and finite, got -0.6",
+        ),
+        ("Polach(ka: 2)", "Polach k_A = 2 is invalid"),
+        ("Fastsim(nx: 10)", "ny"),
+    ] {
+        let e = wheelset_with_creep(law).unwrap_err().to_string();
+        assert!(e.contains(expected), "{law}: {e}");
+    }
+}

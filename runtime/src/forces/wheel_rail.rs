@@ -73,12 +73,10 @@ use crate::equations::BodyKinematics;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{CreepLawKind, RailKind, SlidingZoneKind, WheelRail};
+use railmbs_models::{RailKind, WheelRail};
 use railmbs_track::{SpeedLaw, Track};
-use railmbs_wheelrail::creep::{
-    ContactPatch, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
-    Polach, SlidingZone,
-};
+use railmbs_wheelrail::creep::{ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages};
+use railmbs_wheelrail::creepage::ContactFrame;
 use railmbs_wheelrail::elastic_rail::{
     self, ContactMaterial, CreepStart, ElasticRailError, ElasticRailSettings, RailContact,
     RailContactGeometry, RailSupport,
@@ -154,8 +152,8 @@ struct Constants {
     shear: f64,
     poisson: f64,
     normal_damping: f64,
-    /// Mueller exponent.
-    exponent: f64,
+    /// The creep law, its settings evaluated.
+    creep: CreepLawSpec,
     /// Elastic rails' support (per rail), or `None` for rigid rails.
     rail: Option<RailSupport>,
 }
@@ -923,11 +921,17 @@ impl WheelRailContact {
         // does not feed the spin into the normal damper.
         let omega_frame = wheel.angular_velocity - s.axle * wheel.angular_velocity.dot(&s.axle);
         let approach_rate = -(wheel.velocity + omega_frame.cross(&rho)).dot(&n);
-        let creepages = Creepages {
-            xi: v_wheel.dot(&ex) / s.speed,
-            eta: v_wheel.dot(&ey) / s.speed,
-            phi: wheel.angular_velocity.dot(&n) / s.speed,
+        // Against a rail at rest (the elastic rail's velocity is added by
+        // its solve).
+        let frame = ContactFrame {
+            ex: ex.into(),
+            ey: ey.into(),
+            n: n.into(),
         };
+        let omega = wheel.angular_velocity.into();
+        let creepages =
+            Creepages::from_velocities(v_wheel.into(), [0.0; 3], omega, [0.0; 3], &frame, s.speed)
+                .map_err(|e| self.diverged(t, e.to_string()))?;
         Ok(Some(ContactKinematics {
             shape,
             approach,
@@ -1053,10 +1057,9 @@ impl ForceElement for WheelRailContact {
             shear: young / (2.0 * (1.0 + poisson)),
             poisson,
             normal_damping: ev(&s.normal_damping, "normal_damping")?,
-            exponent: match &s.creep {
-                CreepLawKind::Mueller { exponent } => ev(exponent, "exponent")?,
-                _ => 0.0,
-            },
+            creep: s
+                .creep
+                .try_map(|key, e| eval_scalar(e, params, &name, key))?,
             rail: match &s.rail {
                 RailKind::Rigid => None,
                 RailKind::Elastic { ky, cy, kz, cz } => Some(RailSupport {
@@ -1138,38 +1141,7 @@ impl ForceElement for WheelRailContact {
             ));
         };
         let contact = self.prepare(binding)?;
-        let law: Box<dyn CreepLaw + Send + Sync> = match &self.spec.creep {
-            CreepLawKind::Kalker => Box::new(KalkerLinear),
-            CreepLawKind::Mueller { .. } => {
-                Box::new(Mueller::new(self.c.exponent).map_err(|e| self.err(e))?)
-            }
-            CreepLawKind::Fastsim { nx, ny } => {
-                Box::new(Fastsim::new(*ny, *nx).map_err(|e| self.err(e))?)
-            }
-            CreepLawKind::FastsimA { strips, sliding } => {
-                let zone = match *sliding {
-                    SlidingZoneKind::Continuation => SlidingZone::Continuation,
-                    SlidingZoneKind::Integrated { nodes } => SlidingZone::Integrated { nodes },
-                    SlidingZoneKind::Picard { nodes } => SlidingZone::Picard { nodes },
-                };
-                Box::new(
-                    FastsimA::new(*strips)
-                        .and_then(|f| f.with_sliding(zone))
-                        .map_err(|e| self.err(e))?,
-                )
-            }
-            CreepLawKind::Polach {
-                ka,
-                ks,
-                friction_decrease,
-            } => {
-                let mut p = Polach::new().with_reduction(*ka, *ks);
-                if let Some((a, b)) = friction_decrease {
-                    p = p.and_then(|p| p.with_falling_friction(*a, *b, 0.0));
-                }
-                Box::new(p.map_err(|e| self.err(e))?)
-            }
-        };
+        let law = self.c.creep.build().map_err(|e| self.err(e))?;
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
         self.bound = Some(Bound {
             track: binding.track.clone(),

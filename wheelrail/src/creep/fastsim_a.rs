@@ -1,6 +1,6 @@
-//! FastSim_A: a semi-analytic FASTSIM (after D. Yu. Pogorelov's FastSim_A, seed
-//! paper Sect. 4.3): each strip of the contact ellipse is solved in closed form,
-//! so the cost is proportional to the number of strips only.
+//! FastSim_A: a semi-analytic FASTSIM (D. Yu. Pogorelov's FastSim_A,
+//! Pogorelov 2005, Sect. 4.3): each strip of the contact ellipse is solved in
+//! closed form, so the cost is proportional to the number of strips only.
 //!
 //! On a strip at lateral position `y` with half-length `a_y = a√(1 − y²/b²)`,
 //! with the parabolic traction bound `g(x) = K (a_y² − x²)` and the rigid slip
@@ -8,27 +8,31 @@
 //! `B = η/L2`, `C = φ/(2L3)`:
 //!
 //! - **Adhesion zone** (from the leading edge): the exact solution of FASTSIM's
-//!   differential equation `dp/d(−x) = w` is `p = (a_y − x)·(A, B + C(a_y + x))`.
-//!   With `t = a_y + x` the traction reaches the bound where
-//!   `A² + (B + Ct)² = K²t²`, a quadratic in `t` solved in closed form; the
-//!   adhesion zone is `t* ≤ t ≤ 2a_y`, and its force and moment are polynomial
-//!   integrals.
+//!   differential equation `dp/d(−x) = w` is `p = (a_y − x)·(A, B + C(a_y + x))`
+//!   (Pogorelov 2005, Eq. 20). With `t = a_y + x` the traction reaches the
+//!   bound where `A² + (B + Ct)² = K²t²` (Eq. 21), a quadratic in `t` solved in
+//!   closed form; the adhesion zone is `t* ≤ t ≤ 2a_y`, and its force and
+//!   moment are polynomial integrals (the paper's `dFxa`, `dFya`).
 //! - **Sliding zone** (`−a_y ≤ x ≤ x*`): the traction is on the bound,
 //!   `p = g·e`. The exact direction obeys `dθ/d(−x) = |w| sin(θ_w − θ)/g`
-//!   (FASTSIM's scaling onto the bound), which has no closed-form solution. It is
-//!   approximated by the direction of the adhesion solution continued into the
-//!   sliding zone, `e ≈ d/|d|`, `d = (A, B + C(a_y + x))`: the traction keeps
-//!   turning as the accumulated elastic displacement would. This is exact for
-//!   zero spin (then `d ∥ w` is constant and never turns, and FastSim_A equals
-//!   FASTSIM with infinitely many elements: property 1 of the seed paper), and
+//!   (FASTSIM's scaling onto the bound; Pogorelov 2005, Eqs. 24–25 and 28),
+//!   which has no closed-form solution. It is approximated by the direction of
+//!   the adhesion solution continued into the sliding zone, `e ≈ d/|d|`,
+//!   `d = (A, B + C(a_y + x))` (the paper's approximation, Eq. 26): the
+//!   traction keeps turning as the accumulated elastic displacement would.
+//!   This is exact for zero spin (then `d ∥ w` is constant and never turns, and
+//!   FastSim_A equals FASTSIM with infinitely many elements: property 1 of
+//!   Pogorelov 2005, Sect. 4.3), and
 //!   compared with the rigid-slip direction `w/|w|` (tried first) it reduces the
 //!   error against fine FASTSIM at tread-contact spin from 15–30 % to 1–4 %. The force is
-//!   integrated in closed form: with `u = B + C(a_y + x)` the integrands are
+//!   integrated in closed form (as the paper does, its `dFxs0`, `dFys0`):
+//!   with `u = B + C(a_y + x)` the integrands are
 //!   `polynomial(u)/√(A² + u²)`, and `∫ uᵏ/√(A² + u²) du` (k ≤ 4) are elementary
 //!   (one logarithm, two square roots and two divisions per strip). Where the
 //!   direction turns little over the zone (`|C|ℓ ≤ 0.4|d|`, `d` at the zone's
 //!   midpoint) — always for zero spin — a second-order Taylor expansion of the
-//!   direction about the midpoint is integrated instead: cheaper, free of the
+//!   direction about the midpoint is integrated instead (this crate's own):
+//!   cheaper, free of the
 //!   closed form's cancellation as `C → 0`, and within 5.4e-4 of the closed
 //!   form at the switching threshold (unit test), exact for zero spin.
 //!
@@ -43,12 +47,16 @@
 //!
 //! - [`SlidingZone::Picard`]: one Picard step from the continuation direction,
 //!   `θ₁(t) = θ₀(t*) − (AC/K)∫ₜ^{t*} dt'/(t' r(t'))`, the integral in closed form
-//!   (a logarithm per node). Measured, it does **not** help at tread spin:
+//!   (a logarithm per node): the improved approximation `e¹` at the end of
+//!   Pogorelov 2005, Sect. 4.3 (Eq. 25 with Eq. 26 on its right-hand side),
+//!   for which the paper reports about half the error of Eq. 26 on its Fig. 25
+//!   case. Measured here, it does **not** help at tread spin:
 //!   the step diverges logarithmically towards the trailing edge, where the
 //!   true direction relaxes onto the rigid slip instead (error 6.3 % of the
 //!   force against 4.2 % for the continuation, with 8–16 nodes, on the grid of
 //!   `fastsim_a_against_fine_fastsim`; flange spin: mean error 16 % against 37 %).
-//! - [`SlidingZone::Integrated`] (this module's design; [`FastsimA::integrated`],
+//! - [`SlidingZone::Integrated`] (this project's own, not in the paper;
+//!   [`FastsimA::integrated`],
 //!   [`INTEGRATED_NODES`] = 8 nodes): the traction is stepped from `t*` through
 //!   the nodes. A step first tries FASTSIM's exact elastic update
 //!   `p + ∫ w d(−x)`; if that stays within the bound the point has re-adhered
@@ -79,11 +87,14 @@
 //! integrated zone (8 nodes) about 0.45 million — no cheaper than FASTSIM of
 //! similar accuracy — hence not the default; the Picard step about 0.33 million.
 //!
-//! Deviation from the seed paper: its Sect. 4.3 text (Eqs. 20–21, 26 and the
-//! improved Picard-step approximation) could not be retrieved with the project's
-//! search tool; the adhesion zone above is the exact strip solution the paper
-//! describes, the sliding-zone treatments are this module's own. The default
-//! continuation's error grows with spin: against FASTSIM with 2000–4000
+//! Relation to Pogorelov 2005, Sect. 4.3: the adhesion zone is the paper's
+//! exact strip solution (Eqs. 20–21), the default sliding zone
+//! ([`SlidingZone::Continuation`]) its approximation of Eq. 26 with the
+//! closed-form integral, [`SlidingZone::Picard`] its improved approximation;
+//! [`SlidingZone::Integrated`] and the Taylor branch are this crate's own. The
+//! paper compares it with FASTSIM in tread-contact conditions (Figs. 20–22;
+//! Fig. 20's largest spin, 0.5 1/m with a = 8.4 mm, is `φa ≈ 0.004`). The
+//! default continuation's error grows with spin: against FASTSIM with 2000–4000
 //! elements per strip (same strips) it is at most 4.2 % of the total force for
 //! `|φ|·a ≤ 0.002` (tread contact), up to 7.5 % at `|φ|·a ≈ 0.004`, 4 % on
 //! CONTACT's FASTSIM example (`φa = 0.005`), and tens of percent for
@@ -117,19 +128,23 @@ pub struct FastsimA {
 
 /// How FastSim_A obtains the traction direction in the sliding zone of each
 /// strip (see the module documentation for the measured errors).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SlidingZone {
-    /// The adhesion-continuation direction, integrated in closed form (the
-    /// original FastSim_A of this crate; fastest).
+    /// The adhesion-continuation direction, integrated in closed form: the
+    /// paper's FastSim_A (Pogorelov 2005, Eq. 26); fastest; the default.
+    #[default]
     Continuation,
     /// One Picard step of the direction ODE from the continuation direction,
-    /// `nodes` Gauss nodes per zone (measured: no better than
+    /// the improved approximation of Pogorelov 2005, Sect. 4.3, with `nodes`
+    /// Gauss nodes per zone (measured: no better than
     /// [`Self::Continuation`] at tread spin; kept for comparison).
     Picard {
         /// Gauss nodes per sliding zone, 1..=32.
         nodes: usize,
     },
-    /// The sliding zone integrated node to node (`nodes` Gauss nodes per zone):
+    /// The sliding zone integrated node to node (`nodes` Gauss nodes per zone;
+    /// this project's own, not in Pogorelov 2005):
     /// exact elastic steps where the traction falls below the bound
     /// (re-adhesion), the closed-form solution of the direction ODE with
     /// frozen coefficients where it slides.

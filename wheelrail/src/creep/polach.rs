@@ -8,10 +8,11 @@
 //! - [P05] O. Polach, "Creep forces in simulations of traction vehicles running
 //!   on adhesion limit", Wear 258 (2005) 992–1000.
 //!
-//! The equation numbers of the papers could not be checked (their full text
-//! was not retrievable with the project's search tool); the formulas below are
-//! the published ones as commonly reproduced, cross-checked against a public
-//! port of [P99]'s FORTRAN listing. That port differs in two spin details,
+//! Neither paper is in the project's library (`../shared/papers` holds
+//! Pogorelov 2005, whose Sect. 4.2 does not treat Polach's method), so their
+//! equation numbers are not cited; the formulas below are the published ones
+//! as commonly reproduced, cross-checked against a public port of [P99]'s
+//! FORTRAN listing. That port differs in two spin details,
 //! where this module follows the paper as commonly stated: it takes
 //! `s_yC = η + φa` only when that is *smaller* than `|η|` (then pure spin would
 //! give no force at all, contradicting Kalker's `C23` term which the method
