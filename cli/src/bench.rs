@@ -101,13 +101,8 @@ pub struct Args {
     #[arg(long, default_value_t = 16)]
     pub states: usize,
     /// Creep-force law of every wheel–rail element, overriding the model's,
-    /// as `umsim creep --method`: kalker | mueller[:EXPONENT] | fastsim[:N]
-    /// (N × N elements) | fastsim:nx=NX,ny=NY |
-    /// fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] |
-    /// fastsim-a-integrated[:STRIPS] (integrated sliding zones, 8 nodes) |
-    /// polach[:ka=KA,ks=KS,friction_decrease=A/B]. Defaults as in model files
-    /// (FastSim_A 20 strips, FASTSIM 10 × 10, Mueller exponent 2).
-    #[arg(long)]
+    /// in the syntax of `umsim creep --method` (see `umsim creep --help`).
+    #[arg(long, long_help = crate::creep::LAW_HELP)]
     pub creep: Option<String>,
     /// Build the plugin for any CPU of this architecture instead of this machine's
     /// (`umgen --portable`), to measure what the native CPU features bring.

@@ -37,17 +37,23 @@ pub enum Sliding {
     Picard,
 }
 
+/// The long help of a creep-law argument (`umsim creep --method`, `umsim bench
+/// --creep`): the syntax of [`CreepLawSpec`]'s `FromStr` and its defaults.
+pub(crate) const LAW_HELP: &str = concat!(
+    "Creep-force law and its settings: kalker | mueller[:EXPONENT] | ",
+    "fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY | ",
+    "fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | ",
+    "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]. ",
+    "Defaults: Mueller exponent 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
+    "continuation sliding (8 Gauss nodes for integrated/picard), Polach ",
+    "ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated"
+);
+
 /// Arguments of `umsim creep`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Creep-force law and its settings: kalker | mueller[:EXPONENT] |
-    /// fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY |
-    /// fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] |
-    /// fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B].
-    /// Defaults: Mueller exponent 2, FASTSIM 10 × 10, FastSim_A 20 strips with
-    /// continuation sliding (8 Gauss nodes for integrated/picard), Polach
-    /// ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated
-    #[arg(long, visible_alias = "law", value_name = "LAW")]
+    /// Creep-force law and its settings (`LAW[:key=value,…]`, see `--help`).
+    #[arg(long, visible_alias = "law", value_name = "LAW", long_help = LAW_HELP)]
     pub method: CreepLawSpec,
     /// Number of strips (FASTSIM, FastSim_A): overrides the law's.
     #[arg(long)]
