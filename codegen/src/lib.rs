@@ -31,8 +31,6 @@ pub struct GenerateOptions {
     /// Largest number of instructions per generated function (rustc's time is
     /// superlinear in function size; ~500–1000 lines keep it near-linear).
     pub max_instructions_per_function: usize,
-    /// ABI version to write into the plugin (the loader's).
-    pub abi_version: u32,
     /// Compile for any CPU of the target architecture instead of this machine's
     /// (`-C target-cpu=native`, the default on x86-64). A native plugin is refused, with a
     /// message, on a machine lacking one of its CPU features; a portable one runs anywhere,
@@ -41,14 +39,20 @@ pub struct GenerateOptions {
 }
 
 impl GenerateOptions {
-    /// Defaults for the given ABI version.
-    pub fn new(abi_version: u32) -> Self {
+    /// The defaults: nothing fixed, 600 instructions per function, built for this machine.
+    /// (The plugin's ABI version is the interface's, [`railmbs_plugin_abi::ABI_VERSION`].)
+    pub fn new() -> Self {
         Self {
             fixed: Vec::new(),
             max_instructions_per_function: 600,
-            abi_version,
             portable: false,
         }
+    }
+}
+
+impl Default for GenerateOptions {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
@@ -117,7 +121,6 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
     let start = Instant::now();
     let model_hash = model.structural_hash();
     let header = PluginHeader {
-        abi_version: opts.abi_version,
         model_name: &model.name,
         model_hash: &model_hash,
         coordinate_names: model.coordinates.iter().map(|c| c.name.clone()).collect(),
@@ -157,7 +160,7 @@ pub fn build_plugin(
     cache_dir: Option<PathBuf>,
 ) -> Result<BuiltPlugin, CodegenError> {
     let generated = generate(model, opts)?;
-    let mut build = BuildOptions::new(opts.abi_version);
+    let mut build = BuildOptions::new(railmbs_plugin_abi::ABI_VERSION);
     if !opts.portable {
         build.extra_flags = native_cpu_flags();
     }
