@@ -191,6 +191,82 @@ pub(crate) fn units(d: &Derived, lanes: usize) -> Vec<Unit> {
     units
 }
 
+/// An index or a length as an unsuffixed literal (`mass[3]`, not `mass[3usize]`).
+fn ix(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// The names generated code indexes its inputs with: one `usize` constant per coordinate
+/// (`Q_…`: its index in q, and that of its velocity in v) and per parameter (`P_…`), made
+/// from the model's names.
+pub(crate) struct Names {
+    coordinates: Vec<proc_macro2::Ident>,
+    parameters: Vec<proc_macro2::Ident>,
+}
+
+impl Names {
+    pub(crate) fn new(coordinates: &[String], parameters: &[String]) -> Self {
+        Names {
+            coordinates: constant_names("Q", coordinates),
+            parameters: constant_names("P", parameters),
+        }
+    }
+
+    /// `const Q_… : usize = i;` for every coordinate and parameter, each documented with
+    /// the model's name.
+    fn definitions(&self, coordinates: &[String], parameters: &[String]) -> TokenStream {
+        let define = |idents: &[proc_macro2::Ident], names: &[String], what: &str| {
+            let items = idents.iter().zip(names).enumerate().map(|(i, (id, name))| {
+                let doc = format!(" {what} `{name}`.");
+                let i = ix(i);
+                quote!(#[doc = #doc] const #id: usize = #i;)
+            });
+            quote!(#(#items)*)
+        };
+        let q = define(
+            &self.coordinates,
+            coordinates,
+            "Index in q and v of the coordinate",
+        );
+        let p = define(&self.parameters, parameters, "Index in p of the parameter");
+        quote!(#q #p)
+    }
+}
+
+/// `PREFIX_NAME` constants for `names`: the name's runs of ASCII letters and digits in upper
+/// case, joined by underscores (`Bogie1.WS1.m` → `P_BOGIE1_WS1_M`); the index is appended
+/// to a name that would repeat an earlier one (or stands alone for a name with no such run).
+fn constant_names(prefix: &str, names: &[String]) -> Vec<proc_macro2::Ident> {
+    let mut seen = std::collections::HashSet::new();
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let words: Vec<String> = name
+                .split(|c: char| !c.is_ascii_alphanumeric())
+                .filter(|w| !w.is_empty())
+                .map(|w| w.to_ascii_uppercase())
+                .collect();
+            let mut id = if words.is_empty() {
+                format!("{prefix}_{i}")
+            } else {
+                format!("{prefix}_{}", words.join("_"))
+            };
+            while !seen.insert(id.clone()) {
+                id = format!("{id}_{i}");
+            }
+            format_ident!("{}", id)
+        })
+        .collect()
+}
+
+/// What operands are written with: the names of the inputs and the expression of a
+/// temporary (a local `t_k`, or a scratch slot).
+struct Cx<'a> {
+    names: &'a Names,
+    tmp: &'a dyn Fn(u32) -> TokenStream,
+}
+
 fn lit(x: f64) -> TokenStream {
     // Exact round-trip literal; the sign goes outside for negative numbers.
     if x < 0.0 {
@@ -202,24 +278,48 @@ fn lit(x: f64) -> TokenStream {
     }
 }
 
-fn operand(o: Operand, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+fn operand(o: Operand, local: &Cx) -> TokenStream {
     match o {
-        Operand::Tmp(k) => local(k),
+        Operand::Tmp(k) => (local.tmp)(k),
         Operand::Const(c) => lit(c),
         Operand::Sym(s) => {
             let i = s.index as usize;
             match s.kind {
-                SymbolKind::Coordinate => quote!(q[#i]),
-                SymbolKind::Velocity => quote!(v[#i]),
-                SymbolKind::Parameter => quote!(p[#i]),
-                SymbolKind::Input => quote!(u[#i]),
+                SymbolKind::Coordinate => {
+                    let c = &local.names.coordinates[i];
+                    quote!(q[#c])
+                }
+                SymbolKind::Velocity => {
+                    let c = &local.names.coordinates[i];
+                    quote!(v[#c])
+                }
+                SymbolKind::Parameter => {
+                    let c = &local.names.parameters[i];
+                    quote!(p[#c])
+                }
+                SymbolKind::Input => {
+                    let i = ix(i);
+                    quote!(u[#i])
+                }
                 SymbolKind::Time => quote!(t),
             }
         }
     }
 }
 
-fn instr(i: &Instr, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+/// The operands of an instruction.
+fn instr_operands(i: &Instr) -> Vec<Operand> {
+    match *i {
+        Instr::Add(a, b)
+        | Instr::Sub(a, b)
+        | Instr::Mul(a, b)
+        | Instr::Div(a, b)
+        | Instr::Atan2(a, b) => vec![a, b],
+        Instr::Neg(a) | Instr::Call(_, a) => vec![a],
+    }
+}
+
+fn instr(i: &Instr, local: &Cx) -> TokenStream {
     let o = |x: Operand| operand(x, local);
     match *i {
         Instr::Add(a, b) => {
@@ -271,7 +371,7 @@ fn vector_op(
     start: usize,
     w: usize,
     local_pack: &dyn Fn(usize) -> bool,
-    local: &dyn Fn(u32) -> TokenStream,
+    local: &Cx,
 ) -> TokenStream {
     let ty = format_ident!("F64x{}", w);
     let lane_operands = |pos: usize| -> Vec<Operand> {
@@ -355,11 +455,11 @@ fn mass_pack_store(
     {
         return None;
     }
-    let (a, b) = (row * n + col, row * n + col + w);
+    let (a, b) = (ix(row * n + col), ix(row * n + col + w));
     let v = format_ident!("v{}", start);
     let upper = lanes.iter().enumerate().map(|(l, &(_, r, c))| {
         let id = format_ident!("t{}", start + l);
-        let i = c * n + r;
+        let i = ix(c * n + r);
         quote!(mass[#i] = #id;)
     });
     let tokens = quote! {
@@ -371,11 +471,7 @@ fn mass_pack_store(
 
 /// The batch of sin and cos calls `range` of `prog` (all `Call(Sin | Cos, _)`): one
 /// `sin_cos_batch` call over their distinct arguments, then one `let` per instruction.
-fn trig_batch(
-    prog: &Program,
-    range: std::ops::Range<usize>,
-    local: &dyn Fn(u32) -> TokenStream,
-) -> TokenStream {
+fn trig_batch(prog: &Program, range: std::ops::Range<usize>, local: &Cx) -> TokenStream {
     let mut args: Vec<Operand> = Vec::new();
     let mut lets = Vec::new();
     for k in range {
@@ -387,6 +483,7 @@ fn trig_batch(
             args.len() - 1
         });
         let id = format_ident!("t{}", k);
+        let i = ix(i);
         lets.push(match f {
             CasFunc::Sin => quote!(let #id = trig_sin[#i];),
             _ => quote!(let #id = trig_cos[#i];),
@@ -409,20 +506,38 @@ fn trig_batch(
 fn store(target: Target, value: TokenStream, n: usize) -> TokenStream {
     match target {
         Target::Mass { row, col } => {
-            let a = col * n + row;
+            let a = ix(col * n + row);
             if row == col {
                 quote!(mass[#a] = #value;)
             } else {
-                let b = row * n + col;
+                let b = ix(row * n + col);
                 quote!({ let x = #value; mass[#a] = x; mass[#b] = x; })
             }
         }
-        Target::Bias(i) => quote!(bias[#i] = #value;),
-        Target::Gravity(i) => quote!(gravity[#i] = #value;),
-        Target::Kinematics(i) => quote!(kinematics[#i] = #value;),
-        Target::Jacobian(i) => quote!(jacobians[#i] = #value;),
-        Target::Constraint(i) => quote!(constraints[#i] = #value;),
-        Target::ConstraintJacobian(i) => quote!(constraint_jacobian[#i] = #value;),
+        Target::Bias(i) => {
+            let i = ix(i);
+            quote!(bias[#i] = #value;)
+        }
+        Target::Gravity(i) => {
+            let i = ix(i);
+            quote!(gravity[#i] = #value;)
+        }
+        Target::Kinematics(i) => {
+            let i = ix(i);
+            quote!(kinematics[#i] = #value;)
+        }
+        Target::Jacobian(i) => {
+            let i = ix(i);
+            quote!(jacobians[#i] = #value;)
+        }
+        Target::Constraint(i) => {
+            let i = ix(i);
+            quote!(constraints[#i] = #value;)
+        }
+        Target::ConstraintJacobian(i) => {
+            let i = ix(i);
+            quote!(constraint_jacobian[#i] = #value;)
+        }
     }
 }
 
@@ -453,6 +568,7 @@ fn buffer_len(name: &str, n: usize, nb: usize, nc: usize) -> usize {
 #[allow(clippy::too_many_arguments)]
 fn emit_unit(
     unit: &Unit,
+    names: &Names,
     n: usize,
     n_params: usize,
     n_bodies: usize,
@@ -507,13 +623,14 @@ fn emit_unit(
         .collect();
     for (ci, chunk) in split.chunks.iter().enumerate() {
         let fname = format_ident!("{}_{}", unit.name, ci);
-        let local = |k: u32| {
+        let tmp = |k: u32| {
             let id = format_ident!("t{}", k);
             quote!(#id)
         };
+        let local = Cx { names, tmp: &tmp };
         let loads = chunk.loads.iter().map(|&(t, s)| {
             let id = format_ident!("t{}", t);
-            let s = s as usize;
+            let s = ix(s as usize);
             quote!(let #id = unsafe { s[#s].assume_init() };)
         });
         let body = chunk
@@ -552,7 +669,7 @@ fn emit_unit(
             .filter(|(t, _)| loaded_later.contains(t))
             .map(|&(t, s)| {
                 let id = format_ident!("t{}", t);
-                let s = s as usize;
+                let s = ix(s as usize);
                 quote!(s[#s] = std::mem::MaybeUninit::new(#id);)
             });
         let mut buffers = std::collections::BTreeSet::new();
@@ -580,19 +697,43 @@ fn emit_unit(
         // constants needs no bounds checks.
         let views = buffers.iter().map(|b| {
             let id = format_ident!("{}", b);
-            let len = buffer_len(b, n, n_bodies, n_constraints);
+            let len = ix(buffer_len(b, n, n_bodies, n_constraints));
             quote!(let #id: &mut [f64; #len] = (&mut *o.#id).try_into().expect("host buffer sized by the ABI");)
         });
-        let n_slots_c = n_slots;
+        // Fixed-size views of the inputs the chunk reads (the others are unused).
+        let mut read = [false; 4];
+        for k in chunk.instrs.clone() {
+            for o in instr_operands(&prog.instrs[k]) {
+                if let Operand::Sym(sym) = o {
+                    match sym.kind {
+                        SymbolKind::Coordinate => read[0] = true,
+                        SymbolKind::Velocity => read[1] = true,
+                        SymbolKind::Parameter => read[2] = true,
+                        SymbolKind::Input => read[3] = true,
+                        SymbolKind::Time => {}
+                    }
+                }
+            }
+        }
+        let input_views = [("q", nq), ("v", nq), ("p", np), ("u", nu)]
+            .into_iter()
+            .zip(read)
+            .filter(|&(_, r)| r)
+            .map(|((name, len), _)| {
+                let id = format_ident!("{}", name);
+                let len = ix(len);
+                quote!(let #id: &[f64; #len] = #id.try_into().expect("host buffer sized by the ABI");)
+            });
+        let scratch = (!chunk.loads.is_empty() || !chunk.stores.is_empty()).then(|| {
+            let n_slots = ix(n_slots);
+            quote!(let s: &mut [std::mem::MaybeUninit<f64>; #n_slots] = s.try_into().expect("scratch sized by the generator");)
+        });
         fns.push(quote! {
             #[inline(never)]
             #[allow(unused_variables)]
             fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [std::mem::MaybeUninit<f64>], o: &mut Out) {
-                let q: &[f64; #nq] = q.try_into().expect("host buffer sized by the ABI");
-                let v: &[f64; #nq] = v.try_into().expect("host buffer sized by the ABI");
-                let p: &[f64; #np] = p.try_into().expect("host buffer sized by the ABI");
-                let u: &[f64; #nu] = u.try_into().expect("host buffer sized by the ABI");
-                let s: &mut [std::mem::MaybeUninit<f64>; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
+                #(#input_views)*
+                #scratch
                 #(#views)*
                 #(#loads)*
                 #(#body)*
@@ -604,16 +745,31 @@ fn emit_unit(
         calls.push(quote!(#fname(t, q, v, p, u, &mut s, o);));
         *functions += 1;
     }
-    // Outputs that are inputs or constants (rare: e.g. a constant mass entry).
-    let finals = final_writes.iter().map(|&(oi, op)| {
-        let v = operand(op, &|k| {
-            let slot = split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize;
-            quote!(unsafe { s[#slot].assume_init() })
-        });
-        let b = format_ident!("{}", buffer_name(unit.targets[oi]));
-        let st = store(unit.targets[oi], v, n);
-        quote!({ let #b = &mut *o.#b; #st })
+    // Outputs that are inputs or constants (a parameter on the mass diagonal, 0 and 1 in
+    // the rotation of a planar body), one block per buffer. Constant zeros are structurally
+    // zero entries: the host zeroes its buffers once, and nothing else writes them.
+    let slot = |k: u32| {
+        let slot = ix(split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize);
+        quote!(unsafe { s[#slot].assume_init() })
+    };
+    let from_scratch = Cx { names, tmp: &slot };
+    let mut finals_by_buffer: Vec<(&'static str, Vec<TokenStream>)> = Vec::new();
+    for &(oi, op) in &final_writes {
+        if matches!(op, Operand::Const(c) if c.to_bits() == 0) {
+            continue;
+        }
+        let b = buffer_name(unit.targets[oi]);
+        let st = store(unit.targets[oi], operand(op, &from_scratch), n);
+        match finals_by_buffer.iter_mut().find(|(name, _)| *name == b) {
+            Some((_, stores)) => stores.push(st),
+            None => finals_by_buffer.push((b, vec![st])),
+        }
+    }
+    let finals = finals_by_buffer.iter().map(|(b, stores)| {
+        let b = format_ident!("{}", b);
+        quote!({ let #b = &mut *o.#b; #(#stores)* })
     });
+    let n_slots = ix(n_slots);
     let driver = format_ident!("eval_{}", unit.name);
     *functions += 1;
     quote! {
@@ -682,10 +838,24 @@ pub fn emit(
         }
     }
     stats.ops_cse = cse;
+    let names = Names::new(&header.coordinate_names, &header.parameter_names);
+    let index_names = names.definitions(&header.coordinate_names, &header.parameter_names);
     let mut functions = 0;
     let bodies: Vec<TokenStream> = units
         .iter()
-        .map(|u| emit_unit(u, n, np, nb, nc, d.inputs, max_instrs, &mut functions))
+        .map(|u| {
+            emit_unit(
+                u,
+                &names,
+                n,
+                np,
+                nb,
+                nc,
+                d.inputs,
+                max_instrs,
+                &mut functions,
+            )
+        })
         .collect();
     stats.functions = functions;
     let has_con = nc > 0;
@@ -700,24 +870,71 @@ pub fn emit(
     let name = Literal::byte_string(format!("{}\0", header.model_name).as_bytes());
     let coords = c_string_list(&header.coordinate_names);
     let params = c_string_list(&header.parameter_names);
-    let nfixed = header.fixed.len();
     let ni = d.inputs;
     let nu_len = 3 * ni;
-    let fixed_idx: Vec<TokenStream> = header
+    let fixed_idx = header
         .fixed
         .iter()
-        .map(|&(i, _)| {
-            let i = i as u32;
-            quote!(#i)
-        })
-        .collect();
+        .map(|&(i, _)| Literal::u32_unsuffixed(i as u32));
     let fixed_val: Vec<TokenStream> = header.fixed.iter().map(|&(_, x)| lit(x)).collect();
-    let (mass_len, bias_len, kin_len, jac_len, con_len, cjac_len) =
-        (n * n, n, 18 * nb, 6 * nb * n, nc, nc * n);
+    let count = |k: usize| Literal::u32_unsuffixed(u32::try_from(k).expect("a count below 2^32"));
+    let (c_n, c_nb, c_nc, c_np, c_ni, c_fixed) = (
+        count(n),
+        count(nb),
+        count(nc),
+        count(np),
+        count(ni),
+        count(header.fixed.len()),
+    );
+    let nfixed = ix(header.fixed.len());
+    let (mass_len, bias_len, kin_len, jac_len, cjac_len) =
+        (ix(n * n), ix(n), ix(18 * nb), ix(6 * nb * n), ix(nc * n));
+    // What is known now is decided now: the null checks and slices of the inputs and
+    // buffers this model has.
+    let mut refused = vec![
+        quote!(need_dyn && (ob.mass.is_null() || ob.bias.is_null() || ob.gravity.is_null())),
+        quote!(need_kin && (ob.kinematics.is_null() || ob.jacobians.is_null())),
+    ];
+    if has_con {
+        refused.push(quote!(
+            parts & PART_CONSTRAINTS != 0
+                && (ob.constraints.is_null() || ob.constraint_jacobian.is_null())
+        ));
+    }
+    let input = |name: &str, len: usize| {
+        let id = format_ident!("{}", name);
+        if len == 0 {
+            (None, quote!(let #id: &[f64] = &[];))
+        } else {
+            let len = ix(len);
+            (
+                Some(quote!(i.#id.is_null())),
+                quote!(let #id = std::slice::from_raw_parts(i.#id, #len);),
+            )
+        }
+    };
+    let mut inputs = Vec::new();
+    for (name, len) in [("q", n), ("v", n), ("p", np), ("u", nu_len)] {
+        let (check, slice) = input(name, len);
+        refused.extend(check);
+        inputs.push(slice);
+    }
+    let constraint_buffers = if has_con {
+        let con_len = ix(nc);
+        quote! {
+            constraints: sl_mut(ob.constraints, #con_len),
+            constraint_jacobian: sl_mut(ob.constraint_jacobian, #cjac_len),
+        }
+    } else {
+        quote! {
+            constraints: &mut [],
+            constraint_jacobian: &mut [],
+        }
+    };
     let head = quote! {
         //! Generated by railmbs `umgen`: the equations of motion of one model as
         //! straight-line code. Do not edit; regenerate from the model file.
-        #![allow(clippy::all, non_snake_case, unused_parens)]
+        #![allow(clippy::all, dead_code, non_snake_case, unused_parens)]
     };
     let tokens = quote! {
         use std::os::raw::c_char;
@@ -739,6 +956,8 @@ pub fn emit(
         static FIXED_INDICES: [u32; #nfixed] = [#(#fixed_idx),*];
         static FIXED_VALUES: [f64; #nfixed] = [#(#fixed_val),*];
 
+        #index_names
+
         #(#bodies)*
 
         /// Target features compiled in (`COMPILED_TARGET_FEATURES`). Runs no vector
@@ -758,16 +977,16 @@ pub fn emit(
             }
             *info = PluginInfo {
                 abi_version: ABI_VERSION,
-                dof: #n as u32,
-                bodies: #nb as u32,
-                constraints: #nc as u32,
-                parameters: #np as u32,
-                inputs: #ni as u32,
+                dof: #c_n,
+                bodies: #c_nb,
+                constraints: #c_nc,
+                parameters: #c_np,
+                inputs: #c_ni,
                 model_hash: MODEL_HASH.as_ptr() as *const c_char,
                 model_name: MODEL_NAME.as_ptr() as *const c_char,
                 coordinate_names: COORDINATE_NAMES.as_ptr() as *const c_char,
                 parameter_names: PARAMETER_NAMES.as_ptr() as *const c_char,
-                fixed_count: #nfixed as u32,
+                fixed_count: #c_fixed,
                 fixed_indices: FIXED_INDICES.as_ptr(),
                 fixed_values: FIXED_VALUES.as_ptr(),
             };
@@ -785,36 +1004,23 @@ pub fn emit(
             }
             let i = &*inputs;
             let ob = &*outputs;
-            unsafe fn sl<'a>(p: *const f64, n: usize) -> &'a [f64] {
-                if n == 0 || p.is_null() { &[] } else { std::slice::from_raw_parts(p, n) }
-            }
             unsafe fn sl_mut<'a>(p: *mut f64, n: usize) -> &'a mut [f64] {
                 if n == 0 || p.is_null() { &mut [] } else { std::slice::from_raw_parts_mut(p, n) }
             }
             let need_dyn = parts & PART_DYNAMICS != 0;
             let need_kin = parts & PART_KINEMATICS != 0;
-            if (need_dyn && (ob.mass.is_null() || ob.bias.is_null() || ob.gravity.is_null()))
-                || (need_kin && (ob.kinematics.is_null() || ob.jacobians.is_null()))
-                || ((parts & PART_CONSTRAINTS != 0) && #has_con && (ob.constraints.is_null() || ob.constraint_jacobian.is_null()))
-                || (#n > 0 && (i.q.is_null() || i.v.is_null()))
-                || (#np > 0 && i.p.is_null())
-                || (#nu_len > 0 && i.u.is_null())
-            {
+            if #((#refused))||* {
                 return 1;
             }
             let t = i.t;
-            let q = sl(i.q, #n);
-            let v = sl(i.v, #n);
-            let p = sl(i.p, #np);
-            let u = sl(i.u, #nu_len);
+            #(#inputs)*
             let mut o = Out {
                 mass: sl_mut(if need_dyn { ob.mass } else { std::ptr::null_mut() }, #mass_len),
                 bias: sl_mut(if need_dyn { ob.bias } else { std::ptr::null_mut() }, #bias_len),
                 gravity: sl_mut(if need_dyn { ob.gravity } else { std::ptr::null_mut() }, #bias_len),
                 kinematics: sl_mut(if need_kin { ob.kinematics } else { std::ptr::null_mut() }, #kin_len),
                 jacobians: sl_mut(if need_kin { ob.jacobians } else { std::ptr::null_mut() }, #jac_len),
-                constraints: sl_mut(ob.constraints, #con_len),
-                constraint_jacobian: sl_mut(ob.constraint_jacobian, #cjac_len),
+                #constraint_buffers
             };
             if need_dyn && need_kin {
                 eval_all(t, q, v, p, u, &mut o);
