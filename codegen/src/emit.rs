@@ -129,6 +129,9 @@ pub struct PluginHeader<'a> {
     pub model_hash: &'a str,
     pub coordinate_names: Vec<String>,
     pub parameter_names: Vec<String>,
+    /// Names of the runtime inputs (`<body>.<component>` of each track-following frame;
+    /// 3 numbers each in u: value, rate, acceleration).
+    pub input_names: Vec<String>,
     /// Parameters fixed at generation time, with their values (the plugin still
     /// takes the full parameter vector; the host refuses other values for these).
     pub fixed: Vec<(usize, f64)>,
@@ -197,39 +200,55 @@ fn ix(i: usize) -> Literal {
 }
 
 /// The names generated code indexes its inputs with: one `usize` constant per coordinate
-/// (`Q_…`: its index in q, and that of its velocity in v) and per parameter (`P_…`), made
-/// from the model's names.
+/// (`Q_…`: its index in q, and that of its velocity in v), per parameter (`P_…`) and per
+/// runtime input (`U_…`: the index in u of its value; its rate and acceleration follow),
+/// made from the model's names.
 pub(crate) struct Names {
     coordinates: Vec<proc_macro2::Ident>,
     parameters: Vec<proc_macro2::Ident>,
+    inputs: Vec<proc_macro2::Ident>,
 }
 
 impl Names {
-    pub(crate) fn new(coordinates: &[String], parameters: &[String]) -> Self {
+    pub(crate) fn new(header: &PluginHeader) -> Self {
         Names {
-            coordinates: constant_names("Q", coordinates),
-            parameters: constant_names("P", parameters),
+            coordinates: constant_names("Q", &header.coordinate_names),
+            parameters: constant_names("P", &header.parameter_names),
+            inputs: constant_names("U", &header.input_names),
         }
     }
 
-    /// `const Q_… : usize = i;` for every coordinate and parameter, each documented with
-    /// the model's name.
-    fn definitions(&self, coordinates: &[String], parameters: &[String]) -> TokenStream {
-        let define = |idents: &[proc_macro2::Ident], names: &[String], what: &str| {
-            let items = idents.iter().zip(names).enumerate().map(|(i, (id, name))| {
-                let doc = format!(" {what} `{name}`.");
-                let i = ix(i);
-                quote!(#[doc = #doc] const #id: usize = #i;)
+    /// `const Q_…: usize = i;` for every coordinate, parameter and input; the first of each
+    /// group says what the group indexes (the model's own names are in the plugin's name
+    /// lists).
+    fn definitions(&self) -> TokenStream {
+        let define = |idents: &[proc_macro2::Ident], what: &str, step| {
+            let items = idents.iter().enumerate().map(|(i, id)| {
+                let doc = (i == 0).then(|| quote!(#[doc = #what]));
+                let i = ix(step * i);
+                quote!(#doc const #id: usize = #i;)
             });
             quote!(#(#items)*)
         };
         let q = define(
             &self.coordinates,
-            coordinates,
-            "Index in q and v of the coordinate",
+            " Indices of the coordinates in q (and of their velocities in v), named after the \
+             model's coordinates (`COORDINATE_NAMES`).",
+            1,
         );
-        let p = define(&self.parameters, parameters, "Index in p of the parameter");
-        quote!(#q #p)
+        let p = define(
+            &self.parameters,
+            " Indices of the parameters in p, named after the model's parameters \
+             (`PARAMETER_NAMES`).",
+            1,
+        );
+        let u = define(
+            &self.inputs,
+            " Indices in u of the runtime inputs, the pose components of the track-following \
+             frames (`<body>.<component>`): the value, then its rate and acceleration.",
+            3,
+        );
+        quote!(#q #p #u)
     }
 }
 
@@ -268,12 +287,13 @@ struct Cx<'a> {
 }
 
 fn lit(x: f64) -> TokenStream {
-    // Exact round-trip literal; the sign goes outside for negative numbers.
+    // Exact round-trip literal (f64 by inference: every use is an f64 operand); the sign
+    // goes outside for negative numbers.
     if x < 0.0 {
-        let l = Literal::f64_suffixed(-x);
+        let l = Literal::f64_unsuffixed(-x);
         quote!((-#l))
     } else {
-        let l = Literal::f64_suffixed(x);
+        let l = Literal::f64_unsuffixed(x);
         quote!(#l)
     }
 }
@@ -297,10 +317,17 @@ fn operand(o: Operand, local: &Cx) -> TokenStream {
                     let c = &local.names.parameters[i];
                     quote!(p[#c])
                 }
-                SymbolKind::Input => {
-                    let i = ix(i);
-                    quote!(u[#i])
-                }
+                SymbolKind::Input => match (local.names.inputs.get(i / 3), i % 3) {
+                    (Some(c), 0) => quote!(u[#c]),
+                    (Some(c), d) => {
+                        let d = ix(d);
+                        quote!(u[#c + #d])
+                    }
+                    (None, _) => {
+                        let i = ix(i);
+                        quote!(u[#i])
+                    }
+                },
                 SymbolKind::Time => quote!(t),
             }
         }
@@ -838,8 +865,8 @@ pub fn emit(
         }
     }
     stats.ops_cse = cse;
-    let names = Names::new(&header.coordinate_names, &header.parameter_names);
-    let index_names = names.definitions(&header.coordinate_names, &header.parameter_names);
+    let names = Names::new(header);
+    let index_names = names.definitions();
     let mut functions = 0;
     let bodies: Vec<TokenStream> = units
         .iter()

@@ -125,6 +125,16 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
         model_hash: &model_hash,
         coordinate_names: model.coordinates.iter().map(|c| c.name.clone()).collect(),
         parameter_names: model.parameters.iter().map(|p| p.name.clone()).collect(),
+        input_names: model
+            .track_frames
+            .iter()
+            .flat_map(|f| {
+                let body = &model.bodies[f.body].name;
+                railmbs_models::TRACK_FRAME_COMPONENTS
+                    .iter()
+                    .map(move |c| format!("{body}.{c}"))
+            })
+            .collect(),
         fixed: fixed_idx.iter().map(|&i| (i, defaults[i])).collect(),
     };
     let (source, stats) = emit::emit(
