@@ -125,9 +125,13 @@ pub struct EmitStats {
 
 /// Identity of the generated plugin.
 pub struct PluginHeader<'a> {
+    /// Name of the model.
     pub model_name: &'a str,
+    /// Its structural hash (`Model::structural_hash`), checked by the loader.
     pub model_hash: &'a str,
+    /// Its coordinate names, in order.
     pub coordinate_names: Vec<String>,
+    /// Its parameter names, in order.
     pub parameter_names: Vec<String>,
     /// Names of the runtime inputs (`<body>.<component>` of each track-following frame;
     /// 3 numbers each in u: value, rate, acceleration).

@@ -1,7 +1,7 @@
 //! # railmbs-codegen
 //!
 //! The symbolic path: from a validated [`Model`] to the equations of motion as
-//! expressions ([`derive`], with the `cas` crate), to optimized straight-line
+//! expressions ([`derive`](mod@derive), with the `cas` crate), to optimized straight-line
 //! Rust ([`emit`]: common-subexpression elimination over all outputs, split into
 //! functions of bounded size), to a compiled, cached `cdylib` plugin
 //! ([`build_plugin`], with `build-support`). The `umgen` binary (crate `cli`)
@@ -78,8 +78,15 @@ pub fn native_cpu_flags() -> Vec<String> {
 /// Errors of code generation and compilation.
 #[derive(Debug, thiserror::Error)]
 pub enum CodegenError {
+    /// `--fixed` names an identifier the model does not have.
     #[error("model \"{model}\": --fixed names no identifier \"{name}\"")]
-    UnknownFixed { model: String, name: String },
+    UnknownFixed {
+        /// The model.
+        model: String,
+        /// The name.
+        name: String,
+    },
+    /// Compiling the plugin failed.
     #[error(transparent)]
     Build(#[from] BuildError),
 }
@@ -87,12 +94,15 @@ pub enum CodegenError {
 /// Generated source and what it took.
 #[derive(Debug, Clone)]
 pub struct Generated {
+    /// The plugin's Rust source (one file).
     pub source: String,
+    /// Sizes and times of the emission.
     pub stats: EmitStats,
     /// Symbolic derivation time (expressions of all outputs).
     pub derive_time: Duration,
     /// CSE, splitting and source emission time (see `stats` for the parts).
     pub emit_time: Duration,
+    /// Structural hash of the model, written into the plugin.
     pub model_hash: String,
 }
 
@@ -155,10 +165,13 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
 /// A compiled plugin.
 #[derive(Debug, Clone)]
 pub struct BuiltPlugin {
+    /// The library in the cache.
     pub path: PathBuf,
+    /// Its source and the statistics of generating it.
     pub generated: Generated,
     /// `None` on a cache hit.
     pub compile_time: Option<Duration>,
+    /// Whether the library came from the cache.
     pub cache_hit: bool,
 }
 

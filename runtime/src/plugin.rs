@@ -25,27 +25,49 @@ use std::path::{Path, PathBuf};
 /// Why a plugin cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum PluginError {
+    /// The file is not a shared library the system can load.
     #[error("{path}: not a loadable library: {reason}")]
-    NotALibrary { path: PathBuf, reason: String },
+    NotALibrary {
+        /// The file.
+        path: PathBuf,
+        /// The system loader's message.
+        reason: String,
+    },
+    /// A library without one of the interface's functions.
     #[error("{path}: not a railmbs plugin (missing symbol `{symbol}`)")]
-    MissingSymbol { path: PathBuf, symbol: String },
+    MissingSymbol {
+        /// The library.
+        path: PathBuf,
+        /// The function it lacks.
+        symbol: String,
+    },
     #[error(
         "{path}: plugin ABI version {found}, this umsim needs {expected}; regenerate it with `umgen`"
     )]
+    /// A plugin of another version of the interface.
     AbiVersion {
+        /// The plugin.
         path: PathBuf,
+        /// Its ABI version.
         found: u32,
+        /// This loader's ([`ABI_VERSION`]).
         expected: u32,
     },
     #[error(
         "{path}: plugin was built from another model (plugin: \"{plugin_model}\", hash {plugin_hash}; \
          model file: \"{model}\", hash {model_hash}); regenerate it with `umgen`"
     )]
+    /// A plugin built from another model (structural hash or counts differ).
     ModelMismatch {
+        /// The plugin.
         path: PathBuf,
+        /// Name of the model it was built from.
         plugin_model: String,
+        /// Structural hash of that model.
         plugin_hash: String,
+        /// Name of the model it was loaded for.
         model: String,
+        /// Structural hash of that model.
         model_hash: String,
     },
     #[error(
@@ -53,7 +75,13 @@ pub enum PluginError {
          this machine with `umgen`, or build plugins for several machines with `umgen --portable`",
         missing.join(", ")
     )]
-    CpuFeatures { path: PathBuf, missing: Vec<String> },
+    /// A plugin compiled for CPU features this machine lacks (or the loader cannot confirm).
+    CpuFeatures {
+        /// The plugin.
+        path: PathBuf,
+        /// The features.
+        missing: Vec<String>,
+    },
 }
 
 /// Whether this CPU has the target feature `name` (rustc's name, e.g. `avx2`): `None` if
@@ -119,15 +147,23 @@ pub struct Plugin {
     evaluate: EvaluateFn,
     /// The CPU features the library was compiled with (`railmbs_target_features`).
     pub target_features: Vec<String>,
+    /// Generalized coordinates n.
     pub dof: usize,
+    /// Bodies (ground excluded).
     pub bodies: usize,
+    /// Scalar constraint equations.
     pub constraints: usize,
+    /// Parameters (fixed ones included).
     pub parameters: usize,
     /// Runtime inputs (3 numbers each: value, rate, acceleration).
     pub inputs: usize,
+    /// Name of the model the plugin was built from.
     pub model_name: String,
+    /// Structural hash of that model.
     pub model_hash: String,
+    /// Its coordinate names, in order.
     pub coordinate_names: Vec<String>,
+    /// Its parameter names, in order.
     pub parameter_names: Vec<String>,
     /// (parameter index, value) fixed at generation time.
     pub fixed: Vec<(usize, f64)>,
