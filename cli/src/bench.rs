@@ -614,10 +614,8 @@ fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>>
                 }
                 Ok(_) => {
                     let build_s = start.elapsed().as_secs_f64();
-                    let g = railmbs_codegen::generate(
-                        model,
-                        &railmbs_codegen::GenerateOptions::new(0),
-                    )?;
+                    let g =
+                        railmbs_codegen::generate(model, &railmbs_codegen::GenerateOptions::new())?;
                     let d = g.derive_time.as_secs_f64();
                     add(&mut derive_s, Some(d));
                     add(
@@ -764,7 +762,7 @@ pub fn measure(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
             Ok(first) => {
                 drop(first);
                 let generated =
-                    railmbs_codegen::generate(&model, &railmbs_codegen::GenerateOptions::new(0))?;
+                    railmbs_codegen::generate(&model, &railmbs_codegen::GenerateOptions::new())?;
                 let d = generated.derive_time.as_secs_f64();
                 let emit = generated.emit_time.as_secs_f64();
                 derive_s = Some(d);

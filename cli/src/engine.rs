@@ -2,7 +2,6 @@
 
 use railmbs_codegen::{BuiltPlugin, GenerateOptions};
 use railmbs_models::Model;
-use railmbs_runtime::plugin::ABI_VERSION;
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::path::Path;
 
@@ -21,7 +20,7 @@ pub fn build_symbolic(
     model: &Model,
     portable: bool,
 ) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
-    let mut opts = GenerateOptions::new(ABI_VERSION);
+    let mut opts = GenerateOptions::new();
     opts.portable = portable;
     Ok(railmbs_codegen::build_plugin(model, &opts, None)?)
 }

@@ -2,7 +2,6 @@
 //! the equations of motion symbolically, emit Rust and compile a plugin.
 
 use railmbs_codegen::GenerateOptions;
-use railmbs_runtime::plugin::ABI_VERSION;
 use std::path::PathBuf;
 
 /// Arguments of `umgen`.
@@ -38,7 +37,7 @@ pub struct Args {
 /// Runs `umgen`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = railmbs_models::load_model(&args.model)?;
-    let mut opts = GenerateOptions::new(ABI_VERSION);
+    let mut opts = GenerateOptions::new();
     opts.fixed = args.fixed.clone();
     opts.max_instructions_per_function = args.max_function_size.max(1);
     opts.portable = args.portable;

@@ -25,43 +25,54 @@ pub type M3 = [[ExprId; 3]; 3];
 
 /// Symbolic vector algebra on a [`Context`].
 pub struct Alg<'a> {
+    /// The expression DAG the vectors and matrices live in.
     pub ctx: &'a mut Context,
     zero: ExprId,
     one: ExprId,
 }
 
 impl<'a> Alg<'a> {
+    /// Algebra on `ctx`.
     pub fn new(ctx: &'a mut Context) -> Self {
         let zero = ctx.num(0.0);
         let one = ctx.num(1.0);
         Self { ctx, zero, one }
     }
+    /// The expression 0.
     pub fn zero(&self) -> ExprId {
         self.zero
     }
+    /// The zero vector.
     pub fn v_zero(&self) -> V3 {
         [self.zero; 3]
     }
+    /// The identity matrix E.
     pub fn identity(&self) -> M3 {
         let (z, o) = (self.zero, self.one);
         [[o, z, z], [z, o, z], [z, z, o]]
     }
+    /// a + b.
     pub fn add(&mut self, a: V3, b: V3) -> V3 {
         [0, 1, 2].map(|k| self.ctx.add(a[k], b[k]))
     }
+    /// a − b.
     pub fn sub(&mut self, a: V3, b: V3) -> V3 {
         [0, 1, 2].map(|k| self.ctx.sub(a[k], b[k]))
     }
+    /// s·a for an expression s.
     pub fn scale(&mut self, s: ExprId, a: V3) -> V3 {
         [0, 1, 2].map(|k| self.ctx.mul(s, a[k]))
     }
+    /// s·a for a number s.
     pub fn scale_num(&mut self, s: f64, a: V3) -> V3 {
         [0, 1, 2].map(|k| self.ctx.scale(s, a[k]))
     }
+    /// a · b.
     pub fn dot(&mut self, a: V3, b: V3) -> ExprId {
         let t = [0, 1, 2].map(|k| self.ctx.mul(a[k], b[k]));
         self.ctx.add_many(&t)
     }
+    /// a × b.
     pub fn cross(&mut self, a: V3, b: V3) -> V3 {
         let c = |s: &mut Self, i: usize, j: usize| {
             let x = s.ctx.mul(a[i], b[j]);
@@ -70,21 +81,25 @@ impl<'a> Alg<'a> {
         };
         [c(self, 1, 2), c(self, 2, 0), c(self, 0, 1)]
     }
+    /// Column k of m.
     pub fn column(&self, m: &M3, k: usize) -> V3 {
         [m[0][k], m[1][k], m[2][k]]
     }
+    /// m x.
     pub fn mat_vec(&mut self, m: &M3, x: V3) -> V3 {
         [0, 1, 2].map(|r| {
             let t = [0, 1, 2].map(|c| self.ctx.mul(m[r][c], x[c]));
             self.ctx.add_many(&t)
         })
     }
+    /// mᵀ x.
     pub fn mat_t_vec(&mut self, m: &M3, x: V3) -> V3 {
         [0, 1, 2].map(|c| {
             let t = [0, 1, 2].map(|r| self.ctx.mul(m[r][c], x[r]));
             self.ctx.add_many(&t)
         })
     }
+    /// a b.
     pub fn mat_mul(&mut self, a: &M3, b: &M3) -> M3 {
         [0, 1, 2].map(|r| {
             [0, 1, 2].map(|c| {
@@ -93,6 +108,7 @@ impl<'a> Alg<'a> {
             })
         })
     }
+    /// a + b.
     pub fn mat_add(&mut self, a: &M3, b: &M3) -> M3 {
         [0, 1, 2].map(|r| [0, 1, 2].map(|c| self.ctx.add(a[r][c], b[r][c])))
     }
@@ -166,23 +182,32 @@ pub struct DeriveOptions {
 
 /// The derived equations: expression lists in the order the plugin ABI writes them.
 pub struct Derived {
+    /// The expression DAG all lists below point into.
     pub ctx: Context,
     /// Upper triangle of M by columns: for j in 0..n, i in 0..=j → M[(i, j)]; with the
     /// (i, j) pairs in `mass_index`. Structural zeros are left out.
     pub mass: Vec<ExprId>,
+    /// (row, column) of each entry of `mass`.
     pub mass_index: Vec<(usize, usize)>,
+    /// k, n entries.
     pub bias: Vec<ExprId>,
+    /// Q_g, n entries.
     pub gravity: Vec<ExprId>,
     /// Per body: r (3), A column-major (9), v (3), ω (3).
     pub kinematics: Vec<ExprId>,
     /// Nonzero entries of the stacked Γ (6·nb × n): value and (row, column).
     pub jacobians: Vec<ExprId>,
+    /// (row, column) of each entry of `jacobians`.
     pub jacobian_index: Vec<(usize, usize)>,
+    /// g, nc entries.
     pub constraints: Vec<ExprId>,
     /// Nonzero entries of G (nc × n).
     pub constraint_jacobian: Vec<ExprId>,
+    /// (row, column) of each entry of `constraint_jacobian`.
     pub constraint_jacobian_index: Vec<(usize, usize)>,
+    /// Generalized coordinates n.
     pub dof: usize,
+    /// Bodies (ground excluded).
     pub bodies: usize,
     /// Runtime inputs (each with value, rate, acceleration in `u`).
     pub inputs: usize,

@@ -1,7 +1,9 @@
 //! Rust source of a plugin: straight-line code of the CSE'd programs, split into
-//! functions of bounded size, and the flat `extern "C"` interface of
-//! `railmbs_runtime::plugin` (the caller passes the ABI version it loads with,
-//! `railmbs_runtime::plugin::ABI_VERSION`; the layouts below mirror that module).
+//! functions of bounded size, and the exported functions of the flat `extern "C"`
+//! interface. The interface's types, version and CPU-feature list are not written here:
+//! they are the text of `railmbs_plugin_abi` ([`railmbs_plugin_abi::SOURCE`]), pasted
+//! verbatim into the plugin, whose exported functions are checked against its signatures
+//! when the plugin compiles.
 //!
 //! Programs (each CSE'd over all its outputs together):
 //! - `dyn`: M (nonzero upper-triangle entries), k, Q_g;
@@ -121,48 +123,19 @@ pub struct EmitStats {
     pub format_time: std::time::Duration,
 }
 
-/// x86 target features a plugin reports as compiled in (`railmbs_target_features`), so that
-/// the loader can refuse a plugin built with `-C target-cpu=native` on a machine whose CPU
-/// lacks one, instead of crashing on an illegal instruction. These are the features LLVM may
-/// use by itself in straight-line f64 code (vector widths, FMA, bit manipulation); every one
-/// is detectable by `is_x86_feature_detected!` in `railmbs_runtime::plugin` (a test checks).
-pub const REPORTED_TARGET_FEATURES: [&str; 26] = [
-    "sse3",
-    "ssse3",
-    "sse4.1",
-    "sse4.2",
-    "sse4a",
-    "popcnt",
-    "lzcnt",
-    "bmi1",
-    "bmi2",
-    "movbe",
-    "f16c",
-    "fma",
-    "avx",
-    "avx2",
-    "avx512f",
-    "avx512dq",
-    "avx512cd",
-    "avx512bw",
-    "avx512vl",
-    "avx512ifma",
-    "avx512vbmi",
-    "avx512vbmi2",
-    "avx512vnni",
-    "avx512bitalg",
-    "avx512vpopcntdq",
-    "avx512bf16",
-];
-
 /// Identity of the generated plugin.
 pub struct PluginHeader<'a> {
-    /// ABI version written into the plugin (the loader's `ABI_VERSION`).
-    pub abi_version: u32,
+    /// Name of the model.
     pub model_name: &'a str,
+    /// Its structural hash (`Model::structural_hash`), checked by the loader.
     pub model_hash: &'a str,
+    /// Its coordinate names, in order.
     pub coordinate_names: Vec<String>,
+    /// Its parameter names, in order.
     pub parameter_names: Vec<String>,
+    /// Names of the runtime inputs (`<body>.<component>` of each track-following frame;
+    /// 3 numbers each in u: value, rate, acceleration).
+    pub input_names: Vec<String>,
     /// Parameters fixed at generation time, with their values (the plugin still
     /// takes the full parameter vector; the host refuses other values for these).
     pub fixed: Vec<(usize, f64)>,
@@ -225,35 +198,159 @@ pub(crate) fn units(d: &Derived, lanes: usize) -> Vec<Unit> {
     units
 }
 
+/// An index or a length as an unsuffixed literal (`mass[3]`, not `mass[3usize]`).
+fn ix(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// The names generated code indexes its inputs with: one `usize` constant per coordinate
+/// (`Q_…`: its index in q, and that of its velocity in v), per parameter (`P_…`) and per
+/// runtime input (`U_…`: the index in u of its value; its rate and acceleration follow),
+/// made from the model's names.
+pub(crate) struct Names {
+    coordinates: Vec<proc_macro2::Ident>,
+    parameters: Vec<proc_macro2::Ident>,
+    inputs: Vec<proc_macro2::Ident>,
+}
+
+impl Names {
+    pub(crate) fn new(header: &PluginHeader) -> Self {
+        Names {
+            coordinates: constant_names("Q", &header.coordinate_names),
+            parameters: constant_names("P", &header.parameter_names),
+            inputs: constant_names("U", &header.input_names),
+        }
+    }
+
+    /// `const Q_…: usize = i;` for every coordinate, parameter and input; the first of each
+    /// group says what the group indexes (the model's own names are in the plugin's name
+    /// lists).
+    fn definitions(&self) -> TokenStream {
+        let define = |idents: &[proc_macro2::Ident], what: &str, step| {
+            let items = idents.iter().enumerate().map(|(i, id)| {
+                let doc = (i == 0).then(|| quote!(#[doc = #what]));
+                let i = ix(step * i);
+                quote!(#doc const #id: usize = #i;)
+            });
+            quote!(#(#items)*)
+        };
+        let q = define(
+            &self.coordinates,
+            " Indices of the coordinates in q (and of their velocities in v), named after the \
+             model's coordinates (`COORDINATE_NAMES`).",
+            1,
+        );
+        let p = define(
+            &self.parameters,
+            " Indices of the parameters in p, named after the model's parameters \
+             (`PARAMETER_NAMES`).",
+            1,
+        );
+        let u = define(
+            &self.inputs,
+            " Indices in u of the runtime inputs, the pose components of the track-following \
+             frames (`<body>.<component>`): the value, then its rate and acceleration.",
+            3,
+        );
+        quote!(#q #p #u)
+    }
+}
+
+/// `PREFIX_NAME` constants for `names`: the name's runs of ASCII letters and digits in upper
+/// case, joined by underscores (`Bogie1.WS1.m` → `P_BOGIE1_WS1_M`); the index is appended
+/// to a name that would repeat an earlier one (or stands alone for a name with no such run).
+fn constant_names(prefix: &str, names: &[String]) -> Vec<proc_macro2::Ident> {
+    let mut seen = std::collections::HashSet::new();
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let words: Vec<String> = name
+                .split(|c: char| !c.is_ascii_alphanumeric())
+                .filter(|w| !w.is_empty())
+                .map(|w| w.to_ascii_uppercase())
+                .collect();
+            let mut id = if words.is_empty() {
+                format!("{prefix}_{i}")
+            } else {
+                format!("{prefix}_{}", words.join("_"))
+            };
+            while !seen.insert(id.clone()) {
+                id = format!("{id}_{i}");
+            }
+            format_ident!("{}", id)
+        })
+        .collect()
+}
+
+/// What operands are written with: the names of the inputs and the expression of a
+/// temporary (a local `t_k`, or a scratch slot).
+struct Cx<'a> {
+    names: &'a Names,
+    tmp: &'a dyn Fn(u32) -> TokenStream,
+}
+
 fn lit(x: f64) -> TokenStream {
-    // Exact round-trip literal; the sign goes outside for negative numbers.
+    // Exact round-trip literal (f64 by inference: every use is an f64 operand); the sign
+    // goes outside for negative numbers.
     if x < 0.0 {
-        let l = Literal::f64_suffixed(-x);
+        let l = Literal::f64_unsuffixed(-x);
         quote!((-#l))
     } else {
-        let l = Literal::f64_suffixed(x);
+        let l = Literal::f64_unsuffixed(x);
         quote!(#l)
     }
 }
 
-fn operand(o: Operand, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+fn operand(o: Operand, local: &Cx) -> TokenStream {
     match o {
-        Operand::Tmp(k) => local(k),
+        Operand::Tmp(k) => (local.tmp)(k),
         Operand::Const(c) => lit(c),
         Operand::Sym(s) => {
             let i = s.index as usize;
             match s.kind {
-                SymbolKind::Coordinate => quote!(q[#i]),
-                SymbolKind::Velocity => quote!(v[#i]),
-                SymbolKind::Parameter => quote!(p[#i]),
-                SymbolKind::Input => quote!(u[#i]),
+                SymbolKind::Coordinate => {
+                    let c = &local.names.coordinates[i];
+                    quote!(q[#c])
+                }
+                SymbolKind::Velocity => {
+                    let c = &local.names.coordinates[i];
+                    quote!(v[#c])
+                }
+                SymbolKind::Parameter => {
+                    let c = &local.names.parameters[i];
+                    quote!(p[#c])
+                }
+                SymbolKind::Input => match (local.names.inputs.get(i / 3), i % 3) {
+                    (Some(c), 0) => quote!(u[#c]),
+                    (Some(c), d) => {
+                        let d = ix(d);
+                        quote!(u[#c + #d])
+                    }
+                    (None, _) => {
+                        let i = ix(i);
+                        quote!(u[#i])
+                    }
+                },
                 SymbolKind::Time => quote!(t),
             }
         }
     }
 }
 
-fn instr(i: &Instr, local: &dyn Fn(u32) -> TokenStream) -> TokenStream {
+/// The operands of an instruction.
+fn instr_operands(i: &Instr) -> Vec<Operand> {
+    match *i {
+        Instr::Add(a, b)
+        | Instr::Sub(a, b)
+        | Instr::Mul(a, b)
+        | Instr::Div(a, b)
+        | Instr::Atan2(a, b) => vec![a, b],
+        Instr::Neg(a) | Instr::Call(_, a) => vec![a],
+    }
+}
+
+fn instr(i: &Instr, local: &Cx) -> TokenStream {
     let o = |x: Operand| operand(x, local);
     match *i {
         Instr::Add(a, b) => {
@@ -305,7 +402,7 @@ fn vector_op(
     start: usize,
     w: usize,
     local_pack: &dyn Fn(usize) -> bool,
-    local: &dyn Fn(u32) -> TokenStream,
+    local: &Cx,
 ) -> TokenStream {
     let ty = format_ident!("F64x{}", w);
     let lane_operands = |pos: usize| -> Vec<Operand> {
@@ -389,11 +486,11 @@ fn mass_pack_store(
     {
         return None;
     }
-    let (a, b) = (row * n + col, row * n + col + w);
+    let (a, b) = (ix(row * n + col), ix(row * n + col + w));
     let v = format_ident!("v{}", start);
     let upper = lanes.iter().enumerate().map(|(l, &(_, r, c))| {
         let id = format_ident!("t{}", start + l);
-        let i = c * n + r;
+        let i = ix(c * n + r);
         quote!(mass[#i] = #id;)
     });
     let tokens = quote! {
@@ -405,11 +502,7 @@ fn mass_pack_store(
 
 /// The batch of sin and cos calls `range` of `prog` (all `Call(Sin | Cos, _)`): one
 /// `sin_cos_batch` call over their distinct arguments, then one `let` per instruction.
-fn trig_batch(
-    prog: &Program,
-    range: std::ops::Range<usize>,
-    local: &dyn Fn(u32) -> TokenStream,
-) -> TokenStream {
+fn trig_batch(prog: &Program, range: std::ops::Range<usize>, local: &Cx) -> TokenStream {
     let mut args: Vec<Operand> = Vec::new();
     let mut lets = Vec::new();
     for k in range {
@@ -421,6 +514,7 @@ fn trig_batch(
             args.len() - 1
         });
         let id = format_ident!("t{}", k);
+        let i = ix(i);
         lets.push(match f {
             CasFunc::Sin => quote!(let #id = trig_sin[#i];),
             _ => quote!(let #id = trig_cos[#i];),
@@ -443,20 +537,38 @@ fn trig_batch(
 fn store(target: Target, value: TokenStream, n: usize) -> TokenStream {
     match target {
         Target::Mass { row, col } => {
-            let a = col * n + row;
+            let a = ix(col * n + row);
             if row == col {
                 quote!(mass[#a] = #value;)
             } else {
-                let b = row * n + col;
+                let b = ix(row * n + col);
                 quote!({ let x = #value; mass[#a] = x; mass[#b] = x; })
             }
         }
-        Target::Bias(i) => quote!(bias[#i] = #value;),
-        Target::Gravity(i) => quote!(gravity[#i] = #value;),
-        Target::Kinematics(i) => quote!(kinematics[#i] = #value;),
-        Target::Jacobian(i) => quote!(jacobians[#i] = #value;),
-        Target::Constraint(i) => quote!(constraints[#i] = #value;),
-        Target::ConstraintJacobian(i) => quote!(constraint_jacobian[#i] = #value;),
+        Target::Bias(i) => {
+            let i = ix(i);
+            quote!(bias[#i] = #value;)
+        }
+        Target::Gravity(i) => {
+            let i = ix(i);
+            quote!(gravity[#i] = #value;)
+        }
+        Target::Kinematics(i) => {
+            let i = ix(i);
+            quote!(kinematics[#i] = #value;)
+        }
+        Target::Jacobian(i) => {
+            let i = ix(i);
+            quote!(jacobians[#i] = #value;)
+        }
+        Target::Constraint(i) => {
+            let i = ix(i);
+            quote!(constraints[#i] = #value;)
+        }
+        Target::ConstraintJacobian(i) => {
+            let i = ix(i);
+            quote!(constraint_jacobian[#i] = #value;)
+        }
     }
 }
 
@@ -487,6 +599,7 @@ fn buffer_len(name: &str, n: usize, nb: usize, nc: usize) -> usize {
 #[allow(clippy::too_many_arguments)]
 fn emit_unit(
     unit: &Unit,
+    names: &Names,
     n: usize,
     n_params: usize,
     n_bodies: usize,
@@ -541,13 +654,14 @@ fn emit_unit(
         .collect();
     for (ci, chunk) in split.chunks.iter().enumerate() {
         let fname = format_ident!("{}_{}", unit.name, ci);
-        let local = |k: u32| {
+        let tmp = |k: u32| {
             let id = format_ident!("t{}", k);
             quote!(#id)
         };
+        let local = Cx { names, tmp: &tmp };
         let loads = chunk.loads.iter().map(|&(t, s)| {
             let id = format_ident!("t{}", t);
-            let s = s as usize;
+            let s = ix(s as usize);
             quote!(let #id = unsafe { s[#s].assume_init() };)
         });
         let body = chunk
@@ -586,7 +700,7 @@ fn emit_unit(
             .filter(|(t, _)| loaded_later.contains(t))
             .map(|&(t, s)| {
                 let id = format_ident!("t{}", t);
-                let s = s as usize;
+                let s = ix(s as usize);
                 quote!(s[#s] = std::mem::MaybeUninit::new(#id);)
             });
         let mut buffers = std::collections::BTreeSet::new();
@@ -614,19 +728,43 @@ fn emit_unit(
         // constants needs no bounds checks.
         let views = buffers.iter().map(|b| {
             let id = format_ident!("{}", b);
-            let len = buffer_len(b, n, n_bodies, n_constraints);
+            let len = ix(buffer_len(b, n, n_bodies, n_constraints));
             quote!(let #id: &mut [f64; #len] = (&mut *o.#id).try_into().expect("host buffer sized by the ABI");)
         });
-        let n_slots_c = n_slots;
+        // Fixed-size views of the inputs the chunk reads (the others are unused).
+        let mut read = [false; 4];
+        for k in chunk.instrs.clone() {
+            for o in instr_operands(&prog.instrs[k]) {
+                if let Operand::Sym(sym) = o {
+                    match sym.kind {
+                        SymbolKind::Coordinate => read[0] = true,
+                        SymbolKind::Velocity => read[1] = true,
+                        SymbolKind::Parameter => read[2] = true,
+                        SymbolKind::Input => read[3] = true,
+                        SymbolKind::Time => {}
+                    }
+                }
+            }
+        }
+        let input_views = [("q", nq), ("v", nq), ("p", np), ("u", nu)]
+            .into_iter()
+            .zip(read)
+            .filter(|&(_, r)| r)
+            .map(|((name, len), _)| {
+                let id = format_ident!("{}", name);
+                let len = ix(len);
+                quote!(let #id: &[f64; #len] = #id.try_into().expect("host buffer sized by the ABI");)
+            });
+        let scratch = (!chunk.loads.is_empty() || !chunk.stores.is_empty()).then(|| {
+            let n_slots = ix(n_slots);
+            quote!(let s: &mut [std::mem::MaybeUninit<f64>; #n_slots] = s.try_into().expect("scratch sized by the generator");)
+        });
         fns.push(quote! {
             #[inline(never)]
             #[allow(unused_variables)]
             fn #fname(t: f64, q: &[f64], v: &[f64], p: &[f64], u: &[f64], s: &mut [std::mem::MaybeUninit<f64>], o: &mut Out) {
-                let q: &[f64; #nq] = q.try_into().expect("host buffer sized by the ABI");
-                let v: &[f64; #nq] = v.try_into().expect("host buffer sized by the ABI");
-                let p: &[f64; #np] = p.try_into().expect("host buffer sized by the ABI");
-                let u: &[f64; #nu] = u.try_into().expect("host buffer sized by the ABI");
-                let s: &mut [std::mem::MaybeUninit<f64>; #n_slots_c] = s.try_into().expect("scratch sized by the generator");
+                #(#input_views)*
+                #scratch
                 #(#views)*
                 #(#loads)*
                 #(#body)*
@@ -638,16 +776,31 @@ fn emit_unit(
         calls.push(quote!(#fname(t, q, v, p, u, &mut s, o);));
         *functions += 1;
     }
-    // Outputs that are inputs or constants (rare: e.g. a constant mass entry).
-    let finals = final_writes.iter().map(|&(oi, op)| {
-        let v = operand(op, &|k| {
-            let slot = split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize;
-            quote!(unsafe { s[#slot].assume_init() })
-        });
-        let b = format_ident!("{}", buffer_name(unit.targets[oi]));
-        let st = store(unit.targets[oi], v, n);
-        quote!({ let #b = &mut *o.#b; #st })
+    // Outputs that are inputs or constants (a parameter on the mass diagonal, 0 and 1 in
+    // the rotation of a planar body), one block per buffer. Constant zeros are structurally
+    // zero entries: the host zeroes its buffers once, and nothing else writes them.
+    let slot = |k: u32| {
+        let slot = ix(split.slot_of_tmp[k as usize].expect("output temporary has a slot") as usize);
+        quote!(unsafe { s[#slot].assume_init() })
+    };
+    let from_scratch = Cx { names, tmp: &slot };
+    let mut finals_by_buffer: Vec<(&'static str, Vec<TokenStream>)> = Vec::new();
+    for &(oi, op) in &final_writes {
+        if matches!(op, Operand::Const(c) if c.to_bits() == 0) {
+            continue;
+        }
+        let b = buffer_name(unit.targets[oi]);
+        let st = store(unit.targets[oi], operand(op, &from_scratch), n);
+        match finals_by_buffer.iter_mut().find(|(name, _)| *name == b) {
+            Some((_, stores)) => stores.push(st),
+            None => finals_by_buffer.push((b, vec![st])),
+        }
+    }
+    let finals = finals_by_buffer.iter().map(|(b, stores)| {
+        let b = format_ident!("{}", b);
+        quote!({ let #b = &mut *o.#b; #(#stores)* })
     });
+    let n_slots = ix(n_slots);
     let driver = format_ident!("eval_{}", unit.name);
     *functions += 1;
     quote! {
@@ -716,10 +869,24 @@ pub fn emit(
         }
     }
     stats.ops_cse = cse;
+    let names = Names::new(header);
+    let index_names = names.definitions();
     let mut functions = 0;
     let bodies: Vec<TokenStream> = units
         .iter()
-        .map(|u| emit_unit(u, n, np, nb, nc, d.inputs, max_instrs, &mut functions))
+        .map(|u| {
+            emit_unit(
+                u,
+                &names,
+                n,
+                np,
+                nb,
+                nc,
+                d.inputs,
+                max_instrs,
+                &mut functions,
+            )
+        })
         .collect();
     stats.functions = functions;
     let has_con = nc > 0;
@@ -730,85 +897,78 @@ pub fn emit(
     } else {
         quote!()
     };
-    let abi = header.abi_version;
     let hash = Literal::byte_string(format!("{}\0", header.model_hash).as_bytes());
     let name = Literal::byte_string(format!("{}\0", header.model_name).as_bytes());
     let coords = c_string_list(&header.coordinate_names);
     let params = c_string_list(&header.parameter_names);
-    let nfixed = header.fixed.len();
     let ni = d.inputs;
     let nu_len = 3 * ni;
-    let fixed_idx: Vec<TokenStream> = header
+    let fixed_idx = header
         .fixed
         .iter()
-        .map(|&(i, _)| {
-            let i = i as u32;
-            quote!(#i)
-        })
-        .collect();
+        .map(|&(i, _)| Literal::u32_unsuffixed(i as u32));
     let fixed_val: Vec<TokenStream> = header.fixed.iter().map(|&(_, x)| lit(x)).collect();
-    let (mass_len, bias_len, kin_len, jac_len, con_len, cjac_len) =
-        (n * n, n, 18 * nb, 6 * nb * n, nc, nc * n);
-    let n_features = REPORTED_TARGET_FEATURES.len();
-    let features_cap: usize = REPORTED_TARGET_FEATURES
-        .iter()
-        .map(|f| f.len() + 1)
-        .sum::<usize>()
-        + 1;
-    let feature_names = REPORTED_TARGET_FEATURES.iter();
-    let feature_bytes = REPORTED_TARGET_FEATURES
-        .iter()
-        .map(|f| Literal::byte_string(f.as_bytes()));
-    let tokens = quote! {
+    let count = |k: usize| Literal::u32_unsuffixed(u32::try_from(k).expect("a count below 2^32"));
+    let (c_n, c_nb, c_nc, c_np, c_ni, c_fixed) = (
+        count(n),
+        count(nb),
+        count(nc),
+        count(np),
+        count(ni),
+        count(header.fixed.len()),
+    );
+    let nfixed = ix(header.fixed.len());
+    let (mass_len, bias_len, kin_len, jac_len, cjac_len) =
+        (ix(n * n), ix(n), ix(18 * nb), ix(6 * nb * n), ix(nc * n));
+    // What is known now is decided now: the null checks and slices of the inputs and
+    // buffers this model has.
+    let mut refused = vec![
+        quote!(need_dyn && (ob.mass.is_null() || ob.bias.is_null() || ob.gravity.is_null())),
+        quote!(need_kin && (ob.kinematics.is_null() || ob.jacobians.is_null())),
+    ];
+    if has_con {
+        refused.push(quote!(
+            parts & PART_CONSTRAINTS != 0
+                && (ob.constraints.is_null() || ob.constraint_jacobian.is_null())
+        ));
+    }
+    let input = |name: &str, len: usize| {
+        let id = format_ident!("{}", name);
+        if len == 0 {
+            (None, quote!(let #id: &[f64] = &[];))
+        } else {
+            let len = ix(len);
+            (
+                Some(quote!(i.#id.is_null())),
+                quote!(let #id = std::slice::from_raw_parts(i.#id, #len);),
+            )
+        }
+    };
+    let mut inputs = Vec::new();
+    for (name, len) in [("q", n), ("v", n), ("p", np), ("u", nu_len)] {
+        let (check, slice) = input(name, len);
+        refused.extend(check);
+        inputs.push(slice);
+    }
+    let constraint_buffers = if has_con {
+        let con_len = ix(nc);
+        quote! {
+            constraints: sl_mut(ob.constraints, #con_len),
+            constraint_jacobian: sl_mut(ob.constraint_jacobian, #cjac_len),
+        }
+    } else {
+        quote! {
+            constraints: &mut [],
+            constraint_jacobian: &mut [],
+        }
+    };
+    let head = quote! {
         //! Generated by railmbs `umgen`: the equations of motion of one model as
         //! straight-line code. Do not edit; regenerate from the model file.
-        #![allow(clippy::all, non_snake_case, unused_parens)]
-
+        #![allow(clippy::all, dead_code, non_snake_case, unused_parens)]
+    };
+    let tokens = quote! {
         use std::os::raw::c_char;
-
-        const PART_DYNAMICS: u32 = 1;
-        const PART_KINEMATICS: u32 = 2;
-        const PART_CONSTRAINTS: u32 = 4;
-
-        /// Plugin description (see `railmbs_runtime::plugin::PluginInfo`).
-        #[repr(C)]
-        pub struct PluginInfo {
-            pub abi_version: u32,
-            pub dof: u32,
-            pub bodies: u32,
-            pub constraints: u32,
-            pub parameters: u32,
-            pub inputs: u32,
-            pub model_hash: *const c_char,
-            pub model_name: *const c_char,
-            pub coordinate_names: *const c_char,
-            pub parameter_names: *const c_char,
-            pub fixed_count: u32,
-            pub fixed_indices: *const u32,
-            pub fixed_values: *const f64,
-        }
-
-        /// Host-owned input arrays.
-        #[repr(C)]
-        pub struct Inputs {
-            pub t: f64,
-            pub q: *const f64,
-            pub v: *const f64,
-            pub p: *const f64,
-            pub u: *const f64,
-        }
-
-        /// Host-owned output buffers (column-major matrices).
-        #[repr(C)]
-        pub struct Outputs {
-            pub mass: *mut f64,
-            pub bias: *mut f64,
-            pub gravity: *mut f64,
-            pub kinematics: *mut f64,
-            pub jacobians: *mut f64,
-            pub constraints: *mut f64,
-            pub constraint_jacobian: *mut f64,
-        }
 
         struct Out<'a> {
             mass: &'a mut [f64],
@@ -827,40 +987,18 @@ pub fn emit(
         static FIXED_INDICES: [u32; #nfixed] = [#(#fixed_idx),*];
         static FIXED_VALUES: [f64; #nfixed] = [#(#fixed_val),*];
 
+        #index_names
+
         #(#bodies)*
 
-        /// The target features this library was compiled with, among the ones the loader
-        /// checks: a NUL-terminated, comma-separated list (possibly empty), built at compile
-        /// time from `cfg!(target_feature)`.
-        static TARGET_FEATURES: [u8; #features_cap] = {
-            const NAMES: [(&[u8], bool); #n_features] = [#((#feature_bytes, cfg!(target_feature = #feature_names))),*];
-            let mut out = [0u8; #features_cap];
-            let mut len = 0;
-            let mut i = 0;
-            while i < NAMES.len() {
-                if NAMES[i].1 {
-                    if len > 0 {
-                        out[len] = b',';
-                        len += 1;
-                    }
-                    let mut j = 0;
-                    while j < NAMES[i].0.len() {
-                        out[len] = NAMES[i].0[j];
-                        len += 1;
-                        j += 1;
-                    }
-                }
-                i += 1;
-            }
-            out
-        };
-
-        /// Target features compiled in (see `TARGET_FEATURES`). Runs no vector instruction,
-        /// so the loader may call it before knowing whether this CPU can run the rest.
+        /// Target features compiled in (`COMPILED_TARGET_FEATURES`). Runs no vector
+        /// instruction, so the loader may call it before knowing whether this CPU can run
+        /// the rest.
         #[no_mangle]
         pub extern "C" fn railmbs_target_features() -> *const c_char {
-            TARGET_FEATURES.as_ptr() as *const c_char
+            COMPILED_TARGET_FEATURES.as_ptr() as *const c_char
         }
+        const _: TargetFeaturesFn = railmbs_target_features;
 
         /// Fills `info`. Safety: `info` points to a writable `PluginInfo`.
         #[no_mangle]
@@ -869,21 +1007,22 @@ pub fn emit(
                 return;
             }
             *info = PluginInfo {
-                abi_version: #abi,
-                dof: #n as u32,
-                bodies: #nb as u32,
-                constraints: #nc as u32,
-                parameters: #np as u32,
-                inputs: #ni as u32,
+                abi_version: ABI_VERSION,
+                dof: #c_n,
+                bodies: #c_nb,
+                constraints: #c_nc,
+                parameters: #c_np,
+                inputs: #c_ni,
                 model_hash: MODEL_HASH.as_ptr() as *const c_char,
                 model_name: MODEL_NAME.as_ptr() as *const c_char,
                 coordinate_names: COORDINATE_NAMES.as_ptr() as *const c_char,
                 parameter_names: PARAMETER_NAMES.as_ptr() as *const c_char,
-                fixed_count: #nfixed as u32,
+                fixed_count: #c_fixed,
                 fixed_indices: FIXED_INDICES.as_ptr(),
                 fixed_values: FIXED_VALUES.as_ptr(),
             };
         }
+        const _: InfoFn = railmbs_plugin_info;
 
         /// Evaluates the requested parts. Returns 0, or 1 for a null pointer.
         /// Safety: every pointer refers to a host buffer of the size stated in
@@ -896,36 +1035,23 @@ pub fn emit(
             }
             let i = &*inputs;
             let ob = &*outputs;
-            unsafe fn sl<'a>(p: *const f64, n: usize) -> &'a [f64] {
-                if n == 0 || p.is_null() { &[] } else { std::slice::from_raw_parts(p, n) }
-            }
             unsafe fn sl_mut<'a>(p: *mut f64, n: usize) -> &'a mut [f64] {
                 if n == 0 || p.is_null() { &mut [] } else { std::slice::from_raw_parts_mut(p, n) }
             }
             let need_dyn = parts & PART_DYNAMICS != 0;
             let need_kin = parts & PART_KINEMATICS != 0;
-            if (need_dyn && (ob.mass.is_null() || ob.bias.is_null() || ob.gravity.is_null()))
-                || (need_kin && (ob.kinematics.is_null() || ob.jacobians.is_null()))
-                || ((parts & PART_CONSTRAINTS != 0) && #has_con && (ob.constraints.is_null() || ob.constraint_jacobian.is_null()))
-                || (#n > 0 && (i.q.is_null() || i.v.is_null()))
-                || (#np > 0 && i.p.is_null())
-                || (#nu_len > 0 && i.u.is_null())
-            {
+            if #((#refused))||* {
                 return 1;
             }
             let t = i.t;
-            let q = sl(i.q, #n);
-            let v = sl(i.v, #n);
-            let p = sl(i.p, #np);
-            let u = sl(i.u, #nu_len);
+            #(#inputs)*
             let mut o = Out {
                 mass: sl_mut(if need_dyn { ob.mass } else { std::ptr::null_mut() }, #mass_len),
                 bias: sl_mut(if need_dyn { ob.bias } else { std::ptr::null_mut() }, #bias_len),
                 gravity: sl_mut(if need_dyn { ob.gravity } else { std::ptr::null_mut() }, #bias_len),
                 kinematics: sl_mut(if need_kin { ob.kinematics } else { std::ptr::null_mut() }, #kin_len),
                 jacobians: sl_mut(if need_kin { ob.jacobians } else { std::ptr::null_mut() }, #jac_len),
-                constraints: sl_mut(ob.constraints, #con_len),
-                constraint_jacobian: sl_mut(ob.constraint_jacobian, #cjac_len),
+                #constraint_buffers
             };
             if need_dyn && need_kin {
                 eval_all(t, q, v, p, u, &mut o);
@@ -937,9 +1063,18 @@ pub fn emit(
             #con_call
             0
         }
+        const _: EvaluateFn = railmbs_evaluate;
     };
-    let file: syn::File = syn::parse2(tokens).expect("generated code parses");
-    let mut text = prettyplease::unparse(&file);
+    let unparse = |tokens: TokenStream| {
+        let file: syn::File = syn::parse2(tokens).expect("generated code parses");
+        prettyplease::unparse(&file)
+    };
+    // The header, then the interface (verbatim), then the code.
+    let mut text = unparse(head);
+    text.push('\n');
+    text.push_str(railmbs_plugin_abi::SOURCE);
+    text.push('\n');
+    text.push_str(&unparse(tokens));
     text.push('\n');
     text.push_str(crate::sin_cos::SOURCE);
     text.push('\n');

@@ -31,8 +31,6 @@ pub struct GenerateOptions {
     /// Largest number of instructions per generated function (rustc's time is
     /// superlinear in function size; ~500–1000 lines keep it near-linear).
     pub max_instructions_per_function: usize,
-    /// ABI version to write into the plugin (the loader's).
-    pub abi_version: u32,
     /// Compile for any CPU of the target architecture instead of this machine's
     /// (`-C target-cpu=native`, the default on x86-64). A native plugin is refused, with a
     /// message, on a machine lacking one of its CPU features; a portable one runs anywhere,
@@ -41,14 +39,20 @@ pub struct GenerateOptions {
 }
 
 impl GenerateOptions {
-    /// Defaults for the given ABI version.
-    pub fn new(abi_version: u32) -> Self {
+    /// The defaults: nothing fixed, 600 instructions per function, built for this machine.
+    /// (The plugin's ABI version is the interface's, [`railmbs_plugin_abi::ABI_VERSION`].)
+    pub fn new() -> Self {
         Self {
             fixed: Vec::new(),
             max_instructions_per_function: 600,
-            abi_version,
             portable: false,
         }
+    }
+}
+
+impl Default for GenerateOptions {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
@@ -74,8 +78,15 @@ pub fn native_cpu_flags() -> Vec<String> {
 /// Errors of code generation and compilation.
 #[derive(Debug, thiserror::Error)]
 pub enum CodegenError {
+    /// `--fixed` names an identifier the model does not have.
     #[error("model \"{model}\": --fixed names no identifier \"{name}\"")]
-    UnknownFixed { model: String, name: String },
+    UnknownFixed {
+        /// The model.
+        model: String,
+        /// The name.
+        name: String,
+    },
+    /// Compiling the plugin failed.
     #[error(transparent)]
     Build(#[from] BuildError),
 }
@@ -83,12 +94,15 @@ pub enum CodegenError {
 /// Generated source and what it took.
 #[derive(Debug, Clone)]
 pub struct Generated {
+    /// The plugin's Rust source (one file).
     pub source: String,
+    /// Sizes and times of the emission.
     pub stats: EmitStats,
     /// Symbolic derivation time (expressions of all outputs).
     pub derive_time: Duration,
     /// CSE, splitting and source emission time (see `stats` for the parts).
     pub emit_time: Duration,
+    /// Structural hash of the model, written into the plugin.
     pub model_hash: String,
 }
 
@@ -117,11 +131,20 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
     let start = Instant::now();
     let model_hash = model.structural_hash();
     let header = PluginHeader {
-        abi_version: opts.abi_version,
         model_name: &model.name,
         model_hash: &model_hash,
         coordinate_names: model.coordinates.iter().map(|c| c.name.clone()).collect(),
         parameter_names: model.parameters.iter().map(|p| p.name.clone()).collect(),
+        input_names: model
+            .track_frames
+            .iter()
+            .flat_map(|f| {
+                let body = &model.bodies[f.body].name;
+                railmbs_models::TRACK_FRAME_COMPONENTS
+                    .iter()
+                    .map(move |c| format!("{body}.{c}"))
+            })
+            .collect(),
         fixed: fixed_idx.iter().map(|&i| (i, defaults[i])).collect(),
     };
     let (source, stats) = emit::emit(
@@ -142,10 +165,13 @@ pub fn generate(model: &Model, opts: &GenerateOptions) -> Result<Generated, Code
 /// A compiled plugin.
 #[derive(Debug, Clone)]
 pub struct BuiltPlugin {
+    /// The library in the cache.
     pub path: PathBuf,
+    /// Its source and the statistics of generating it.
     pub generated: Generated,
     /// `None` on a cache hit.
     pub compile_time: Option<Duration>,
+    /// Whether the library came from the cache.
     pub cache_hit: bool,
 }
 
@@ -157,7 +183,7 @@ pub fn build_plugin(
     cache_dir: Option<PathBuf>,
 ) -> Result<BuiltPlugin, CodegenError> {
     let generated = generate(model, opts)?;
-    let mut build = BuildOptions::new(opts.abi_version);
+    let mut build = BuildOptions::new(railmbs_plugin_abi::ABI_VERSION);
     if !opts.portable {
         build.extra_flags = native_cpu_flags();
     }

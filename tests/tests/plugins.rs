@@ -13,10 +13,10 @@ fn cache() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins")
 }
 
-fn build(model: &railmbs_models::Model, abi: u32) -> PathBuf {
+fn build(model: &railmbs_models::Model) -> PathBuf {
     railmbs_codegen::build_plugin(
         model,
-        &railmbs_codegen::GenerateOptions::new(abi),
+        &railmbs_codegen::GenerateOptions::new(),
         Some(cache()),
     )
     .unwrap_or_else(|e| panic!("{e}"))
@@ -26,7 +26,7 @@ fn build(model: &railmbs_models::Model, abi: u32) -> PathBuf {
 #[test]
 fn plugin_of_another_model_is_refused() {
     let pendulum = mechanism("pendulum");
-    let path = build(&pendulum, railmbs_runtime::plugin::ABI_VERSION);
+    let path = build(&pendulum);
     // Structural change: one more elementary transformation.
     let mut changed = pendulum.clone();
     changed.bodies[0].joint.push(railmbs_models::Elementary {
@@ -51,8 +51,25 @@ fn plugin_of_another_model_is_refused() {
 
 #[test]
 fn plugin_of_another_abi_version_is_refused() {
+    // The generated source with the interface's one version constant changed: what a
+    // plugin of another railmbs would be.
     let model = mechanism("pendulum");
-    let path = build(&model, railmbs_runtime::plugin::ABI_VERSION + 100);
+    let source = railmbs_codegen::generate(&model, &railmbs_codegen::GenerateOptions::new())
+        .unwrap()
+        .source;
+    let abi = railmbs_runtime::plugin::ABI_VERSION;
+    let line = format!("pub const ABI_VERSION: u32 = {abi};");
+    assert_eq!(source.matches(&line).count(), 1, "{line}");
+    let other = source.replace(
+        &line,
+        &format!("pub const ABI_VERSION: u32 = {};", abi + 100),
+    );
+    let path = railmbs_build_support::build_plugin(
+        &other,
+        &railmbs_build_support::BuildOptions::new(abi + 100).with_cache_dir(cache()),
+    )
+    .unwrap()
+    .path;
     let err = Plugin::load_for(&path, &model).unwrap_err();
     assert!(matches!(err, PluginError::AbiVersion { .. }), "{err}");
     assert!(err.to_string().contains("ABI version"), "{err}");
@@ -76,6 +93,45 @@ fn a_file_that_is_not_a_plugin_is_refused() {
     let err = Plugin::load_for(&lib.path, &model).unwrap_err();
     assert!(matches!(err, PluginError::MissingSymbol { .. }), "{err}");
     assert!(err.to_string().contains("railmbs_plugin_info"), "{err}");
+}
+
+#[test]
+fn the_plugin_and_the_loader_share_one_interface() {
+    // The generated source holds the interface verbatim, once: the same text the loader
+    // compiles as `railmbs_plugin_abi`, whose types it calls the plugin through.
+    let model = mechanism("double_pendulum");
+    let source = railmbs_codegen::generate(&model, &railmbs_codegen::GenerateOptions::new())
+        .unwrap()
+        .source;
+    let abi = railmbs_runtime::plugin::abi::SOURCE;
+    assert_eq!(source.matches(abi).count(), 1);
+    // Nothing of the interface is written a second time around it.
+    let rest = source.replace(abi, "");
+    for item in [
+        "struct PluginInfo",
+        "struct Inputs",
+        "struct Outputs",
+        "ABI_VERSION: u32 =",
+        "PART_DYNAMICS: u32 =",
+        "\"avx512f\"",
+    ] {
+        assert!(
+            !rest.contains(item),
+            "`{item}` written outside the interface"
+        );
+    }
+    // The exported functions are checked against the interface's signatures, which the
+    // loader's symbol types are.
+    for check in [
+        "const _: InfoFn = railmbs_plugin_info;",
+        "const _: TargetFeaturesFn = railmbs_target_features;",
+        "const _: EvaluateFn = railmbs_evaluate;",
+    ] {
+        assert!(rest.contains(check), "{check}");
+    }
+    // A plugin built from it loads (the loader checks its version).
+    let plugin = Plugin::load_for(&build(&model), &model).unwrap();
+    assert_eq!(plugin.dof, model.coordinates.len());
 }
 
 #[test]
@@ -103,7 +159,7 @@ fn a_plugin_for_cpu_features_this_machine_lacks_is_refused() {
     );
     // Every feature a generated plugin may report can be checked on this machine.
     if cfg!(target_arch = "x86_64") {
-        for f in railmbs_codegen::emit::REPORTED_TARGET_FEATURES {
+        for f in railmbs_runtime::plugin::abi::TARGET_FEATURES {
             assert!(
                 railmbs_runtime::plugin::host_has_target_feature(f).is_some(),
                 "the loader cannot check {f}"
@@ -117,9 +173,8 @@ fn native_and_portable_plugins_report_their_cpu_features_and_agree() {
     // The default plugin is built for this CPU and loads here; the portable one reports
     // only the baseline (no AVX); both give the same mass matrix to rounding.
     let model = mechanism("double_pendulum");
-    let abi = railmbs_runtime::plugin::ABI_VERSION;
-    let native = build(&model, abi);
-    let mut opts = railmbs_codegen::GenerateOptions::new(abi);
+    let native = build(&model);
+    let mut opts = railmbs_codegen::GenerateOptions::new();
     opts.portable = true;
     let portable = railmbs_codegen::build_plugin(&model, &opts, Some(cache()))
         .unwrap()
@@ -162,7 +217,7 @@ fn native_and_portable_plugins_report_their_cpu_features_and_agree() {
 #[test]
 fn fixed_parameters_are_folded_and_other_values_refused() {
     let model = mechanism("pendulum");
-    let mut opts = railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
+    let mut opts = railmbs_codegen::GenerateOptions::new();
     opts.fixed = vec!["l".into(), "r".into()];
     let built = railmbs_codegen::build_plugin(&model, &opts, Some(cache())).unwrap();
     let plugin = Plugin::load_for(&built.path, &model).unwrap();

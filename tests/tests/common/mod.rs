@@ -191,8 +191,7 @@ pub fn symbolic_engine(model: &Model) -> railmbs_runtime::PluginEquations {
         map.entry(hash)
             .or_insert_with(|| {
                 let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins");
-                let opts =
-                    railmbs_codegen::GenerateOptions::new(railmbs_runtime::plugin::ABI_VERSION);
+                let opts = railmbs_codegen::GenerateOptions::new();
                 railmbs_codegen::build_plugin(model, &opts, Some(cache))
                     .unwrap_or_else(|e| panic!("{}: {e}", model.name))
                     .path
