@@ -21,7 +21,6 @@ pub struct ModelSystem {
     /// set from an accepted state; the first evaluation sets them from the
     /// initial state.
     forces_initialized: bool,
-    recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
     /// Zeros, the velocity argument of constraint evaluations.
     zero_velocity: Vec<f64>,
     /// The engine's generalized coordinates n; the force elements' first-order
@@ -106,22 +105,12 @@ impl ModelSystem {
             dynamics_parts,
             jacobian_scratch: JacobianScratch::new(model.coordinates.len()),
             forces_initialized: false,
-            recorder: None,
             zero_velocity: Vec::new(),
             n_coordinates: model.coordinates.len(),
             states: vec![0.0; n_states],
             state_rates: vec![0.0; n_states],
             state_owners,
         })
-    }
-
-    /// Attaches (or detaches) the output recorder whose pending rows are
-    /// written at every accepted step.
-    pub(crate) fn set_recorder(
-        &mut self,
-        recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
-    ) {
-        self.recorder = recorder;
     }
 
     /// Connects the force elements that need the track (wheel–rail contact)
@@ -333,7 +322,7 @@ impl MechanicalSystem for ModelSystem {
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
         if !self.forces_initialized {
-            self.accept_forces(t, q, v);
+            self.accept_forces(t, q, v)?;
         }
         let (q, v) = self.take_states(q, v);
         self.equations
@@ -434,29 +423,22 @@ impl MechanicalSystem for ModelSystem {
         Ok(true)
     }
 
-    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {
-        self.accept_forces(t, q, v);
-        if let Some(rec) = self.recorder.take() {
-            rec.borrow_mut().flush(self);
-            self.recorder = Some(rec);
-        }
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
+        self.accept_forces(t, q, v)
     }
 }
 
 impl ModelSystem {
-    fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) {
+    /// Tells the force elements that (t, q, q̇) is accepted (their states
+    /// update); fails when the kinematics there cannot be evaluated.
+    fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
         self.forces_initialized = true;
         if self.forces.is_empty() {
-            return;
+            return Ok(());
         }
         let (q, v) = self.take_states(q, v);
-        if self
-            .equations
-            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)
-            .is_err()
-        {
-            return;
-        }
+        self.equations
+            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)?;
         let ctx = ForceContext {
             t,
             bodies: &self.eval.bodies,
@@ -467,5 +449,6 @@ impl ModelSystem {
         for f in &mut self.forces {
             f.accept_step(&ctx);
         }
+        Ok(())
     }
 }

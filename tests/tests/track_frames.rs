@@ -161,7 +161,7 @@ fn tc1_free_body_error(tol: f64) -> (f64, usize) {
     let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tc1.csv");
-    let summary = railmbs_runtime::simulate::run_scenario(
+    let summary = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         Box::new(NumericEquations::new(&model)),
@@ -214,7 +214,7 @@ fn a_free_body_on_manchester_track_case_1_goes_straight_in_sc0() {
         railmbs_models::load_scenario(&scenario_path).unwrap_or_else(|e| panic!("{e}"));
     let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     scenario.track = None;
-    let err = railmbs_runtime::simulate::run_scenario(
+    let err = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         Box::new(NumericEquations::new(&model)),
