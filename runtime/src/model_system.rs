@@ -4,6 +4,7 @@
 
 use crate::equations::{Equations, Evaluation, Parts};
 use crate::forces::{self, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Wrench};
+use crate::run::assessment::LoadSample;
 use crate::system::{MechanicalSystem, SimError};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
@@ -31,6 +32,8 @@ pub struct ModelSystem {
     state_rates: Vec<f64>,
     /// Per element with states: (element index, offset into z, count).
     state_owners: Vec<(usize, usize, usize)>,
+    /// Wheel loads of the last accepted step, for the run's assessment.
+    accepted_loads: Vec<LoadSample>,
 }
 
 impl std::fmt::Debug for ModelSystem {
@@ -110,6 +113,7 @@ impl ModelSystem {
             states: vec![0.0; n_states],
             state_rates: vec![0.0; n_states],
             state_owners,
+            accepted_loads: Vec::new(),
         })
     }
 
@@ -122,9 +126,10 @@ impl ModelSystem {
         Ok(())
     }
 
-    /// Assessment maxima of all force elements (end-of-run summary).
-    pub fn assessment(&self) -> Vec<forces::Assessment> {
-        self.forces.iter().flat_map(|f| f.assessment()).collect()
+    /// Moves the wheel loads of the last accepted step (one sample per
+    /// wheel–rail element, keyed by element index) to `out`.
+    pub fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        out.append(&mut self.accepted_loads);
     }
 
     /// The buffers of the last evaluation (by `dynamics`, `force_jacobian` or
@@ -446,7 +451,11 @@ impl ModelSystem {
             states: &self.states,
             state_rates: &self.state_rates,
         };
-        for f in &mut self.forces {
+        self.accepted_loads.clear();
+        for (key, f) in self.forces.iter_mut().enumerate() {
+            if let Some(loads) = f.assessment_loads(&ctx) {
+                self.accepted_loads.push(LoadSample { key, t, loads });
+            }
             f.accept_step(&ctx);
         }
         Ok(())

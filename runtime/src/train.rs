@@ -21,16 +21,19 @@
 
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
-    Assessment, Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch,
-    Linear6, Wrench, add_generalized_force,
+    Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
+    add_generalized_force,
 };
 use crate::model_system::ModelSystem;
+use crate::run::assessment::LoadSample;
 use crate::run::columns::{Columns, arc_position, columns};
 use crate::run::grid::Row;
 use crate::run::scenario::{
     check_integrator, continuous_velocities, drive_track_frames, scenario_state,
 };
-use crate::run::{CsvFile, Discard, OutputSink, RowColumns, RunError, RunSummary, Runner};
+use crate::run::{
+    CsvFile, Discard, OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner,
+};
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
@@ -221,19 +224,31 @@ impl TrainSystem {
         &self.couplers
     }
 
-    /// Assessment maxima of every vehicle, element names prefixed by the
+    /// Moves the wheel loads of the last accepted step of every vehicle to
+    /// `out`, keyed by the element's place in the train (vehicle by
+    /// vehicle, element by element; see [`TrainSystem::assessment_name`]).
+    pub fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        let mut offset = 0;
+        for s in &mut self.vehicles {
+            let start = out.len();
+            s.take_assessment_loads(out);
+            for sample in &mut out[start..] {
+                sample.key += offset;
+            }
+            offset += s.forces().len();
+        }
+    }
+
+    /// Long name of the element with assessment key `key`, prefixed by its
     /// vehicle's name.
-    pub fn assessment(&self) -> Vec<Assessment> {
-        self.vehicles
-            .iter()
-            .zip(&self.names)
-            .flat_map(|(s, name)| {
-                s.assessment().into_iter().map(move |mut a| {
-                    a.element = format!("{name}.{}", a.element);
-                    a
-                })
-            })
-            .collect()
+    pub fn assessment_name(&self, mut key: usize) -> String {
+        for (s, name) in self.vehicles.iter().zip(&self.names) {
+            if key < s.forces().len() {
+                return format!("{name}.{}", s.forces()[key].name());
+            }
+            key -= s.forces().len();
+        }
+        String::new()
     }
 
     /// Kinematics of both bodies of coupler `c` from the vehicles' last
@@ -444,6 +459,16 @@ impl MechanicalSystem for TrainSystem {
     }
 }
 
+impl RunSystem for TrainSystem {
+    fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        TrainSystem::take_assessment_loads(self, out);
+    }
+
+    fn assessment_name(&self, key: usize) -> String {
+        TrainSystem::assessment_name(self, key)
+    }
+}
+
 /// The output columns of a train: `time`, `s[m]` (the train's reference
 /// point), each vehicle's columns prefixed by its name, the couplers'.
 struct TrainColumns {
@@ -643,7 +668,7 @@ pub fn run_train_into(
     let mut summary = RunSummary::new(names.join("+"));
     let start = Instant::now();
     // Each vehicle keeps its bodies' absolute velocities across a kink.
-    let (rows, last_step) = runner.run(
+    let (rows, last_step, assessment) = runner.run(
         &mut system,
         (&q0, &v0),
         &columns,
@@ -667,6 +692,6 @@ pub fn run_train_into(
         },
     )?;
     let cpu_time = start.elapsed().as_secs_f64();
-    summary.finish(cpu_time, rows, last_step, system.assessment());
+    summary.finish(cpu_time, rows, last_step, assessment);
     Ok(summary)
 }

@@ -3,14 +3,20 @@
 //! the track), interpolates output rows onto the output grid ([`grid`]),
 //! evaluates the output columns ([`columns`]) and hands the rows to an
 //! [`OutputSink`] ([`sink`]: a CSV file, an in-memory [`Table`]) while the
-//! run goes on (a run that stops early keeps what it has written).
+//! run goes on (a run that stops early keeps what it has written); the wheel
+//! loads of every accepted step go to the sinks too, and the
+//! [`AssessmentReducer`] ([`assessment`]) makes the run's EN 14363 table of
+//! them.
 //! [`scenario`] turns a scenario into an initial state and a driven engine.
 
+pub mod assessment;
 pub mod columns;
 pub mod grid;
 pub mod scenario;
 pub mod sink;
+pub mod sliding_mean;
 
+pub use assessment::{AssessmentReducer, LoadSample};
 pub use columns::xyz_angles;
 pub use scenario::{InitialState, scenario_state};
 pub use sink::{CsvFile, Discard, OutputSink, Table};
@@ -150,6 +156,45 @@ pub(crate) trait RowColumns<S> {
     ) -> Result<(), RunError>;
 }
 
+/// What the runner needs of a system besides integrating it: the wheel
+/// loads of its accepted steps for the assessment.
+pub(crate) trait RunSystem: MechanicalSystem {
+    /// Moves the wheel loads of the last accepted step to `out` (nothing
+    /// when they were taken already).
+    fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>);
+
+    /// Long name of the element with assessment key `key`.
+    fn assessment_name(&self, key: usize) -> String;
+}
+
+impl RunSystem for ModelSystem {
+    fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        ModelSystem::take_assessment_loads(self, out);
+    }
+
+    fn assessment_name(&self, key: usize) -> String {
+        self.forces()[key].name().to_string()
+    }
+}
+
+/// The wheel loads the system's last accepted step left, to both the
+/// reducer and the sink.
+fn pass_loads<S: RunSystem>(
+    system: &mut S,
+    buffer: &mut Vec<LoadSample>,
+    reducer: &mut AssessmentReducer,
+    sink: &mut dyn OutputSink,
+) {
+    buffer.clear();
+    system.take_assessment_loads(buffer);
+    if buffer.is_empty() {
+        return;
+    }
+    let name = |k: usize| system.assessment_name(k);
+    reducer.accepted_loads(buffer, &name);
+    sink.accepted_loads(buffer, &name);
+}
+
 /// A solver of the scenario's integrator for `system` at (t0, q0, v0).
 fn solver<'s, S: MechanicalSystem>(
     system: &'s mut S,
@@ -189,6 +234,10 @@ struct Rows {
     written: usize,
     /// The first failure (evaluating or writing a row); the run stops.
     failure: Option<RunError>,
+    /// The assessment of the accepted steps' wheel loads.
+    reducer: AssessmentReducer,
+    /// Reusable buffer of wheel loads.
+    loads: Vec<LoadSample>,
 }
 
 impl Rows {
@@ -235,15 +284,15 @@ impl Runner<'_> {
     /// the velocities `restart` gives: continuous absolute velocities), and
     /// writes the rows of `columns` to `sink`. Adds the segments' counts to
     /// `summary` and stores a simulation error there (the rows up to it are
-    /// written); returns the rows written and the time of the last accepted
-    /// step, or the sink's error.
+    /// written); returns the rows written, the time of the last accepted
+    /// step and the assessment table, or the sink's error.
     ///
     /// A row is evaluated after the step following the one that reached it
     /// has been accepted (and at the end): the force elements' accepted
     /// states, which some outputs show, are those of that step, as they
     /// always were.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn run<S: MechanicalSystem>(
+    pub(crate) fn run<S: RunSystem>(
         &self,
         system: &mut S,
         (q0, v0): (&[f64], &[f64]),
@@ -252,7 +301,7 @@ impl Runner<'_> {
         summary: &mut RunSummary,
         progress: &mut impl FnMut(f64),
         mut restart: impl FnMut(&mut S, f64, f64, &[f64], &[f64]) -> Result<Vec<f64>, SimError>,
-    ) -> Result<(usize, Option<f64>), RunError> {
+    ) -> Result<(usize, Option<f64>, Vec<crate::forces::Assessment>), RunError> {
         sink.begin(columns.header())?;
         let mut schedule = OutputSchedule::new(self.t_end, self.interval, q0.len());
         let mut rows = Rows {
@@ -261,6 +310,8 @@ impl Runner<'_> {
             scratch: Vec::new(),
             written: 0,
             failure: None,
+            reducer: AssessmentReducer::new(),
+            loads: Vec::new(),
         };
         let (mut t0, mut q, mut v) = (0.0, q0.to_vec(), v0.to_vec());
         for (k, &breakpoint) in self.breakpoints.iter().chain([&self.t_end]).enumerate() {
@@ -306,14 +357,14 @@ impl Runner<'_> {
         sink.finish()?;
         match rows.failure {
             Some(e) => Err(e),
-            None => Ok((rows.written, schedule.last_time())),
+            None => Ok((rows.written, schedule.last_time(), rows.reducer.table())),
         }
     }
 
     /// One segment from `t0` (state `q`, `v`) to `t1`; `None` when the sink
     /// failed.
     #[allow(clippy::too_many_arguments)]
-    fn segment<S: MechanicalSystem>(
+    fn segment<S: RunSystem>(
         &self,
         system: &mut S,
         (t0, q, v, t1): (f64, &[f64], &[f64], f64),
@@ -328,11 +379,20 @@ impl Runner<'_> {
         }
         let mut solver = solver(system, self.integrator, t0, q, v)?;
         solver.set_stop_time(t1)?;
+        // The first evaluation of a run accepts the initial state.
+        pass_loads(
+            &mut **solver.system_mut(),
+            &mut rows.loads,
+            &mut rows.reducer,
+            sink,
+        );
         let s = solver.state();
         schedule.observe(s.t, s.q, s.v, s.accel, &mut rows.pending, progress);
         while solver.t() < t1 {
             solver.step()?;
-            rows.flush(&mut **solver.system_mut(), columns, sink);
+            let system = &mut **solver.system_mut();
+            pass_loads(system, &mut rows.loads, &mut rows.reducer, sink);
+            rows.flush(system, columns, sink);
             if rows.failure.is_some() {
                 return Ok(None);
             }
@@ -448,7 +508,7 @@ pub fn run_scenario_into(
     let mut summary = RunSummary::new(engine);
     let start = Instant::now();
     // Restart at each kink with continuous absolute velocities.
-    let (rows, last_step) = runner.run(
+    let (rows, last_step, assessment) = runner.run(
         &mut system,
         (&q0, &v0),
         &columns,
@@ -458,6 +518,6 @@ pub fn run_scenario_into(
         scenario::continuous_velocities,
     )?;
     let cpu_time = start.elapsed().as_secs_f64();
-    summary.finish(cpu_time, rows, last_step, system.assessment());
+    summary.finish(cpu_time, rows, last_step, assessment);
     Ok(summary)
 }

@@ -1,9 +1,10 @@
 //! Where output rows go: an [`OutputSink`] receives the header once, then
 //! every row in time order, then the end of the run. [`CsvFile`] writes what
 //! `umsim run` writes; [`Table`] keeps the columns in memory by name;
-//! [`Discard`] only counts.
+//! [`Discard`] only counts; [`AssessmentReducer`](super::AssessmentReducer)
+//! reduces the accepted steps' wheel loads to the EN 14363 table.
 
-use super::RunError;
+use super::{LoadSample, RunError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -21,6 +22,11 @@ pub trait OutputSink {
     /// The sink's own; the run then stops and returns the error.
     fn row(&mut self, values: &[f64]) -> Result<(), RunError>;
 
+    /// The wheel loads of an accepted step, one sample per wheel–rail
+    /// element (`name` gives an element's long name by key). Ignored by
+    /// default; [`AssessmentReducer`](super::AssessmentReducer) reduces them.
+    fn accepted_loads(&mut self, _samples: &[LoadSample], _name: &dyn Fn(usize) -> String) {}
+
     /// The end of the run (also after a simulation error): flush.
     ///
     /// # Errors
@@ -37,6 +43,10 @@ impl<T: OutputSink + ?Sized> OutputSink for &mut T {
 
     fn row(&mut self, values: &[f64]) -> Result<(), RunError> {
         (**self).row(values)
+    }
+
+    fn accepted_loads(&mut self, samples: &[LoadSample], name: &dyn Fn(usize) -> String) {
+        (**self).accepted_loads(samples, name);
     }
 
     fn finish(&mut self) -> Result<(), RunError> {
