@@ -66,13 +66,13 @@
 //! rejected; the step size follows `h·0.9·err^(−1/(p+1))`, limited to
 //! [0.2, 1.6]·h, kept unchanged when the factor lies in [1, 1.2] (to reuse the
 //! factorization), capped by `max_step`, and the last steps are adjusted to
-//! end exactly at `t_end`.
+//! end exactly at the stop time ([`Stepper::set_stop_time`]).
 //!
 //! Velocities of coordinates that appear in the constraints are index-2
 //! variables of the index-3 system: their error enters the norm multiplied by
 //! min(h, 1) (Hairer & Wanner's RADAU5 scaling), otherwise the Newton error
 //! δq/β in v would drive the step size down without end. The last steps
-//! approach `t_end` in at most five equal steps.
+//! approach the stop time in at most five equal steps.
 //!
 //! # Accuracy of accelerations and multipliers (constrained systems)
 //!
@@ -140,7 +140,7 @@ pub struct ParkSettings {
     /// Source of ∂f/∂q and ∂f/∂q̇.
     pub jacobian: JacobianKind,
     /// Constant step `initial_step` without error control (the last step is
-    /// shortened to hit `t_end`); rtol/atol then only set the Newton accuracy.
+    /// shortened to hit the stop time); rtol/atol then only set the Newton accuracy.
     /// Meant for convergence studies.
     pub fixed_step: bool,
     /// Newton iterations per step attempt before the attempt fails (≥ 1).

@@ -379,7 +379,7 @@ impl MechanicalSystem for ModelSystem {
         Ok(())
     }
 
-    /// The approximate analytic Jacobian of the paper's Sect. 6 (Eq. 31):
+    /// The approximate analytic Jacobian of Pogorelov 2005, Sect. 6 (Eq. 31):
     /// ∂f/∂q ≈ Σ_elements Gᵀ C_loc G and ∂f/∂q̇ ≈ Σ Gᵀ D_loc G from the force
     /// elements' local Jacobians ([`ForceElement::add_jacobian`]); the
     /// derivatives of the inertia, gyroscopic and gravity terms and of the
