@@ -34,7 +34,7 @@
 use crate::engine::{Engine, build_engine, build_engine_with};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::{Model, Scenario};
-use railmbs_runtime::simulate::run_scenario;
+use railmbs_runtime::run::run_scenario;
 use railmbs_runtime::{Equations, Evaluation, MechanicalSystem, ModelSystem, Parts};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -1,7 +1,7 @@
 //! `umsim run SCENARIO.ron [--engine numeric|symbolic] [--plugin FILE] [-o out.csv]`.
 
 use crate::engine::{Engine, build_engine};
-use railmbs_runtime::simulate::{RunSummary, run_scenario};
+use railmbs_runtime::run::{RunSummary, run_scenario};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 

@@ -22,7 +22,7 @@ use std::time::Duration;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
-use railmbs_runtime::simulate::run_scenario;
+use railmbs_runtime::run::run_scenario;
 use railmbs_runtime::{
     Equations, Evaluation, MechanicalSystem, ModelSystem, NumericEquations, Parts,
 };

@@ -21,7 +21,7 @@ pub trait InputProvider: Send {
     /// Times in (t0, t1) at which an input's rate may jump (a kink in the
     /// track: the ends of linear cant ramps, section joints), in increasing
     /// order. A run stops there and restarts with velocities that keep every
-    /// body's absolute velocity continuous (`simulate::run_scenario`).
+    /// body's absolute velocity continuous (`run::run_scenario`).
     fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
         Vec::new()
     }

@@ -1,19 +1,20 @@
 //! # railmbs-runtime
 //!
 //! The simulator's library: numeric-iterative equations of motion
-//! ([`numeric`]), force elements ([`forces`]), integrators ([`integrate`]:
-//! Park's implicit method, RK4), and the glue that makes a model with
-//! parameters an integrable system ([`model_system`]).
+//! ([`numeric`]), force elements ([`forces`]), the glue that makes a model
+//! with parameters an integrable system ([`model_system`], trains in
+//! [`train`]), and the runner that owns a run's time loop and writes its
+//! output columns to a sink ([`run`]). The integrators (Park's implicit
+//! method, RK4) are the crate `railmbs-integrate`, re-exported as
+//! [`integrate`].
 
 pub mod equations;
 pub mod forces;
 pub mod inputs;
-pub mod integrate;
 pub mod model_system;
 pub mod numeric;
 pub mod plugin;
-pub mod simulate;
-pub mod system;
+pub mod run;
 pub mod track_inputs;
 pub mod train;
 
@@ -22,5 +23,7 @@ pub use inputs::{DrivenEquations, InputProvider};
 pub use model_system::ModelSystem;
 pub use numeric::NumericEquations;
 pub use plugin::{Plugin, PluginEquations, PluginError};
-pub use system::{MechanicalSystem, SimError};
+pub use railmbs_integrate as integrate;
+pub use railmbs_integrate::system;
+pub use railmbs_integrate::{MechanicalSystem, SimError, Stepper};
 pub use track_inputs::TrackInputs;

@@ -4,6 +4,7 @@
 
 use crate::equations::{Equations, Evaluation, Parts};
 use crate::forces::{self, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Wrench};
+use crate::run::assessment::LoadSample;
 use crate::system::{MechanicalSystem, SimError};
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
@@ -21,7 +22,6 @@ pub struct ModelSystem {
     /// set from an accepted state; the first evaluation sets them from the
     /// initial state.
     forces_initialized: bool,
-    recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
     /// Zeros, the velocity argument of constraint evaluations.
     zero_velocity: Vec<f64>,
     /// The engine's generalized coordinates n; the force elements' first-order
@@ -32,6 +32,8 @@ pub struct ModelSystem {
     state_rates: Vec<f64>,
     /// Per element with states: (element index, offset into z, count).
     state_owners: Vec<(usize, usize, usize)>,
+    /// Wheel loads of the last accepted step, for the run's assessment.
+    accepted_loads: Vec<LoadSample>,
 }
 
 impl std::fmt::Debug for ModelSystem {
@@ -106,22 +108,13 @@ impl ModelSystem {
             dynamics_parts,
             jacobian_scratch: JacobianScratch::new(model.coordinates.len()),
             forces_initialized: false,
-            recorder: None,
             zero_velocity: Vec::new(),
             n_coordinates: model.coordinates.len(),
             states: vec![0.0; n_states],
             state_rates: vec![0.0; n_states],
             state_owners,
+            accepted_loads: Vec::new(),
         })
-    }
-
-    /// Attaches (or detaches) the output recorder whose pending rows are
-    /// written at every accepted step.
-    pub(crate) fn set_recorder(
-        &mut self,
-        recorder: Option<std::rc::Rc<std::cell::RefCell<crate::simulate::Recorder>>>,
-    ) {
-        self.recorder = recorder;
     }
 
     /// Connects the force elements that need the track (wheel–rail contact)
@@ -133,9 +126,10 @@ impl ModelSystem {
         Ok(())
     }
 
-    /// Assessment maxima of all force elements (end-of-run summary).
-    pub fn assessment(&self) -> Vec<forces::Assessment> {
-        self.forces.iter().flat_map(|f| f.assessment()).collect()
+    /// Moves the wheel loads of the last accepted step (one sample per
+    /// wheel–rail element, keyed by element index) to `out`.
+    pub fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        out.append(&mut self.accepted_loads);
     }
 
     /// The buffers of the last evaluation (by `dynamics`, `force_jacobian` or
@@ -333,7 +327,7 @@ impl MechanicalSystem for ModelSystem {
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
         if !self.forces_initialized {
-            self.accept_forces(t, q, v);
+            self.accept_forces(t, q, v)?;
         }
         let (q, v) = self.take_states(q, v);
         self.equations
@@ -385,7 +379,7 @@ impl MechanicalSystem for ModelSystem {
         Ok(())
     }
 
-    /// The approximate analytic Jacobian of the paper's Sect. 6 (Eq. 31):
+    /// The approximate analytic Jacobian of Pogorelov 2005, Sect. 6 (Eq. 31):
     /// ∂f/∂q ≈ Σ_elements Gᵀ C_loc G and ∂f/∂q̇ ≈ Σ Gᵀ D_loc G from the force
     /// elements' local Jacobians ([`ForceElement::add_jacobian`]); the
     /// derivatives of the inertia, gyroscopic and gravity terms and of the
@@ -434,29 +428,22 @@ impl MechanicalSystem for ModelSystem {
         Ok(true)
     }
 
-    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {
-        self.accept_forces(t, q, v);
-        if let Some(rec) = self.recorder.take() {
-            rec.borrow_mut().flush(self);
-            self.recorder = Some(rec);
-        }
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
+        self.accept_forces(t, q, v)
     }
 }
 
 impl ModelSystem {
-    fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) {
+    /// Tells the force elements that (t, q, q̇) is accepted (their states
+    /// update); fails when the kinematics there cannot be evaluated.
+    fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
         self.forces_initialized = true;
         if self.forces.is_empty() {
-            return;
+            return Ok(());
         }
         let (q, v) = self.take_states(q, v);
-        if self
-            .equations
-            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)
-            .is_err()
-        {
-            return;
-        }
+        self.equations
+            .evaluate(t, q, v, Parts::KINEMATICS, &mut self.eval)?;
         let ctx = ForceContext {
             t,
             bodies: &self.eval.bodies,
@@ -464,8 +451,13 @@ impl ModelSystem {
             states: &self.states,
             state_rates: &self.state_rates,
         };
-        for f in &mut self.forces {
+        self.accepted_loads.clear();
+        for (key, f) in self.forces.iter_mut().enumerate() {
+            if let Some(loads) = f.assessment_loads(&ctx) {
+                self.accepted_loads.push(LoadSample { key, t, loads });
+            }
             f.accept_step(&ctx);
         }
+        Ok(())
     }
 }

@@ -1,8 +1,9 @@
 //! Trains: several vehicles, each a model with its own engine (numeric, or
 //! the compiled plugin of its model file), running on one track at arc
 //! offsets from the train's reference point, coupled by coupler force
-//! elements between bodies of different vehicles (external subsystems, seed
-//! paper Sect. 5).
+//! elements between bodies of different vehicles (external subsystems,
+//! Pogorelov 2005, Sect. 5). A train runs on the same runner as a single
+//! vehicle ([`crate::run`]), with its own output columns.
 //!
 //! The assembled system ([`TrainSystem`]) stacks the vehicles' coordinates in
 //! vehicle order: its mass matrix is block-diagonal (one block per vehicle),
@@ -20,22 +21,25 @@
 
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
-    Assessment, Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch,
-    Linear6, Wrench, add_generalized_force,
+    Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
+    add_generalized_force,
 };
 use crate::model_system::ModelSystem;
-use crate::simulate::{
-    Columns, CsvSink, OutputSchedule, RunError, RunSummary, arc_position, check_integrator,
-    columns, continuous_velocities, drive_track_frames, integrate_segments, scenario_state,
+use crate::run::assessment::LoadSample;
+use crate::run::columns::{Columns, arc_position, columns};
+use crate::run::grid::Row;
+use crate::run::scenario::{
+    check_integrator, continuous_velocities, drive_track_frames, scenario_state,
+};
+use crate::run::{
+    CsvFile, Discard, OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner,
 };
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
 use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model, TrainCoupler, TrainScenario};
-use std::cell::RefCell;
 use std::ops::Range;
 use std::path::Path;
-use std::rc::Rc;
 use std::time::Instant;
 
 /// A coupler between body `bodies[0]` of vehicle `vehicles[0]` and body
@@ -121,7 +125,6 @@ pub struct TrainSystem {
     g: Vec<DVector<f64>>,
     gq: Vec<DMatrix<f64>>,
     scratch: JacobianScratch,
-    recorder: Option<Rc<RefCell<TrainRecorder>>>,
 }
 
 impl std::fmt::Debug for TrainSystem {
@@ -188,7 +191,6 @@ impl TrainSystem {
             ranges,
             constraint_ranges,
             couplers,
-            recorder: None,
         })
     }
 
@@ -222,19 +224,31 @@ impl TrainSystem {
         &self.couplers
     }
 
-    /// Assessment maxima of every vehicle, element names prefixed by the
+    /// Moves the wheel loads of the last accepted step of every vehicle to
+    /// `out`, keyed by the element's place in the train (vehicle by
+    /// vehicle, element by element; see [`TrainSystem::assessment_name`]).
+    pub fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        let mut offset = 0;
+        for s in &mut self.vehicles {
+            let start = out.len();
+            s.take_assessment_loads(out);
+            for sample in &mut out[start..] {
+                sample.key += offset;
+            }
+            offset += s.forces().len();
+        }
+    }
+
+    /// Long name of the element with assessment key `key`, prefixed by its
     /// vehicle's name.
-    pub fn assessment(&self) -> Vec<Assessment> {
-        self.vehicles
-            .iter()
-            .zip(&self.names)
-            .flat_map(|(s, name)| {
-                s.assessment().into_iter().map(move |mut a| {
-                    a.element = format!("{name}.{}", a.element);
-                    a
-                })
-            })
-            .collect()
+    pub fn assessment_name(&self, mut key: usize) -> String {
+        for (s, name) in self.vehicles.iter().zip(&self.names) {
+            if key < s.forces().len() {
+                return format!("{name}.{}", s.forces()[key].name());
+            }
+            key -= s.forces().len();
+        }
+        String::new()
     }
 
     /// Kinematics of both bodies of coupler `c` from the vehicles' last
@@ -436,40 +450,55 @@ impl MechanicalSystem for TrainSystem {
         Ok(true)
     }
 
-    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) {
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
         for (k, s) in self.vehicles.iter_mut().enumerate() {
             let r = self.ranges[k].clone();
-            s.accept_step(t, &q[r.clone()], &v[r]);
+            s.accept_step(t, &q[r.clone()], &v[r])?;
         }
-        if let Some(rec) = self.recorder.take() {
-            rec.borrow_mut().flush(self);
-            self.recorder = Some(rec);
-        }
+        Ok(())
     }
 }
 
-/// Output rows of a train waiting to be written (see `simulate::Recorder`).
-struct TrainRecorder {
+impl RunSystem for TrainSystem {
+    fn take_assessment_loads(&mut self, out: &mut Vec<LoadSample>) {
+        TrainSystem::take_assessment_loads(self, out);
+    }
+
+    fn assessment_name(&self, key: usize) -> String {
+        TrainSystem::assessment_name(self, key)
+    }
+}
+
+/// The output columns of a train: `time`, `s[m]` (the train's reference
+/// point), each vehicle's columns prefixed by its name, the couplers'.
+struct TrainColumns {
+    header: Vec<String>,
     /// The reference point's speed law and the offset of the vehicle it
     /// belongs to (the column `s[m]` is the train's reference arc position).
     arc: Option<(RunningSpeed, f64)>,
-    columns: Vec<Columns>,
-    sink: CsvSink,
+    vehicles: Vec<Columns>,
 }
 
-impl TrainRecorder {
-    fn flush(&mut self, train: &mut TrainSystem) {
-        let (arc, columns) = (&self.arc, &self.columns);
-        self.sink.drain(|values, force_values, row| {
-            if let Some((arc, offset)) = arc {
-                values.push(arc_position(arc, row.t)? - offset);
-            }
-            for (k, cols) in columns.iter().enumerate() {
-                let vehicle_row = row.slice(train.range(k));
-                cols.values(train.vehicle_mut(k), vehicle_row, values, force_values)?;
-            }
-            Ok(train.coupler_outputs(row.t, &row.q, &row.v, values)?)
-        });
+impl RowColumns<TrainSystem> for TrainColumns {
+    fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    fn values(
+        &self,
+        train: &mut TrainSystem,
+        row: &Row,
+        values: &mut Vec<f64>,
+        scratch: &mut Vec<f64>,
+    ) -> Result<(), RunError> {
+        if let Some((arc, offset)) = &self.arc {
+            values.push(arc_position(arc, row.t)? - offset);
+        }
+        for (k, cols) in self.vehicles.iter().enumerate() {
+            let vehicle_row = row.slice(train.range(k));
+            cols.values(train.vehicle_mut(k), vehicle_row, values, scratch)?;
+        }
+        Ok(train.coupler_outputs(row.t, &row.q, &row.v, values)?)
     }
 }
 
@@ -477,13 +506,17 @@ impl TrainRecorder {
 /// at which any vehicle's frames pass a kink of the track, and the output
 /// header.
 pub struct TrainSetup {
+    /// The assembled system.
     pub system: TrainSystem,
+    /// Initial coordinates, stacked in vehicle order.
     pub q0: Vec<f64>,
+    /// Initial velocities.
     pub v0: Vec<f64>,
+    /// Times at which a vehicle's frames pass a kink of the track, s.
     pub breakpoints: Vec<f64>,
+    /// The output header.
     pub header: Vec<String>,
-    columns: Vec<Columns>,
-    arc: Option<(RunningSpeed, f64)>,
+    columns: TrainColumns,
 }
 
 /// Builds the train of `train` from its vehicles' models (`models`, in
@@ -577,9 +610,12 @@ pub fn build_train(
         q0,
         v0,
         breakpoints,
-        header,
-        columns: columns_all,
-        arc,
+        header: header.clone(),
+        columns: TrainColumns {
+            header,
+            arc,
+            vehicles: columns_all,
+        },
     })
 }
 
@@ -587,12 +623,26 @@ pub fn build_train(
 /// order) and writes the output CSV to `output` (if given): columns `time`,
 /// `s[m]` (the train's reference point), then each vehicle's columns prefixed
 /// by its name (`Coach2.Bogie1.WS1.contact.L.Q[N]`), then the couplers'
-/// forces (`C12.Fx[N]` …). As [`crate::simulate::run_scenario`] otherwise.
+/// forces (`C12.Fx[N]` …). As [`crate::run::run_scenario`] otherwise.
 pub fn run_train(
     train: &TrainScenario,
     models: &[&Model],
     engines: Vec<Box<dyn Equations>>,
     output: Option<&Path>,
+    progress: impl FnMut(f64),
+) -> Result<RunSummary, RunError> {
+    match output {
+        Some(path) => run_train_into(train, models, engines, &mut CsvFile::new(path), progress),
+        None => run_train_into(train, models, engines, &mut Discard, progress),
+    }
+}
+
+/// [`run_train`] writing the rows to `sink`.
+pub fn run_train_into(
+    train: &TrainScenario,
+    models: &[&Model],
+    engines: Vec<Box<dyn Equations>>,
+    sink: &mut dyn OutputSink,
     mut progress: impl FnMut(f64),
 ) -> Result<RunSummary, RunError> {
     let mut names: Vec<String> = Vec::new();
@@ -606,33 +656,25 @@ pub fn run_train(
         q0,
         v0,
         breakpoints,
-        header,
         columns,
-        arc,
+        ..
     } = build_train(train, models, engines)?;
-    let recorder = Rc::new(RefCell::new(TrainRecorder {
-        sink: CsvSink::open(output, &header)?,
-        arc,
-        columns,
-    }));
-    system.recorder = Some(recorder.clone());
-
-    let t_end = train.end_time;
-    let mut schedule = OutputSchedule::new(t_end, train.output.interval, q0.len());
-    let start = Instant::now();
-    let mut observer = |t: f64, q: &[f64], v: &[f64], a: &[f64]| {
-        schedule.observe_into(t, q, v, a, &mut recorder.borrow_mut().sink, &mut progress)
+    let runner = Runner {
+        integrator: &train.integrator,
+        breakpoints: &breakpoints,
+        t_end: train.end_time,
+        interval: train.output.interval,
     };
     let mut summary = RunSummary::new(names.join("+"));
+    let start = Instant::now();
     // Each vehicle keeps its bodies' absolute velocities across a kink.
-    integrate_segments(
+    let (rows, last_step, assessment) = runner.run(
         &mut system,
-        &train.integrator,
         (&q0, &v0),
-        &breakpoints,
-        t_end,
-        &mut observer,
+        &columns,
+        sink,
         &mut summary,
+        &mut progress,
         |system: &mut TrainSystem, t_prev, t0, q, v| {
             let mut out = v.to_vec();
             for kv in 0..system.vehicle_count() {
@@ -648,13 +690,8 @@ pub fn run_train(
             }
             Ok(out)
         },
-    );
-
+    )?;
     let cpu_time = start.elapsed().as_secs_f64();
-    system.recorder = None;
-    let mut rec = recorder.borrow_mut();
-    rec.flush(&mut system);
-    let rows = rec.sink.close()?;
-    summary.finish(cpu_time, rows, schedule.last_time(), system.assessment());
+    summary.finish(cpu_time, rows, last_step, assessment);
     Ok(summary)
 }

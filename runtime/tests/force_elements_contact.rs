@@ -391,7 +391,8 @@ fn element_forces_match_hand_computed_values() {
     // x = 0.6 with f0 = 0 (accepted at rest), then F = 1000 (x − 0.6) up to
     // the limit 50 N.
     let (mut sys, ..) = system(&model, &[]);
-    sys.accept_step(0.0, &[0.6, 0.0, 0.0], &[0.0, 0.0, 0.0]);
+    sys.accept_step(0.0, &[0.6, 0.0, 0.0], &[0.0, 0.0, 0.0])
+        .unwrap();
     let out = outputs(&mut sys, &[0.63, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     assert!((out[5] - 30.0).abs() < 1e-9, "{out:?}");
     assert_eq!(out[8], 0.0, "sticking");
@@ -401,13 +402,15 @@ fn element_forces_match_hand_computed_values() {
         "held at the static limit: {out:?}"
     );
     // Accepted beyond the limit: sliding at Fs = 40 N against the velocity.
-    sys.accept_step(0.0, &[0.7, 0.0, 0.0], &[0.1, 0.0, 0.0]);
+    sys.accept_step(0.0, &[0.7, 0.0, 0.0], &[0.1, 0.0, 0.0])
+        .unwrap();
     let out = outputs(&mut sys, &[0.72, 0.0, 0.0], &[0.1, 0.0, 0.0]);
     assert!((out[5] - 40.0).abs() < 1e-12 && out[8] == 1.0, "{out:?}");
     // Sliding stops when the speed falls below V_STICK = 1e-4 m/s: sticks
     // with the current force f0 = 40 N stored at x0 = 0.72; 1 cm shorter the
     // tension is 40 − 1000·0.01 = 30 N.
-    sys.accept_step(0.0, &[0.72, 0.0, 0.0], &[5e-5, 0.0, 0.0]);
+    sys.accept_step(0.0, &[0.72, 0.0, 0.0], &[5e-5, 0.0, 0.0])
+        .unwrap();
     let out = outputs(&mut sys, &[0.71, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     assert!((out[5] - 30.0).abs() < 1e-9 && out[8] == 0.0, "{out:?}");
 
@@ -444,7 +447,7 @@ fn load_dependent_friction_loop_energy_is_independent_of_frequency() {
                 let q = [0.5 + u, 0.0, 0.0];
                 let vel = [v, 0.0, 0.0];
                 let f = outputs(&mut sys, &q, &vel)[9];
-                sys.accept_step(t, &q, &vel);
+                sys.accept_step(t, &q, &vel).unwrap();
                 if cycle == 2 {
                     if let Some((u0, f0)) = prev {
                         // Work done on the element: the tension F resists extension.
@@ -528,7 +531,7 @@ fn new_elements_local_jacobians_equal_central_differences() {
         }
         // Store modes and anchors at the state, then move a little so the
         // sticking springs are loaded.
-        sys.accept_step(0.0, &q, &v);
+        sys.accept_step(0.0, &q, &v).unwrap();
         let q: Vec<f64> = q
             .iter()
             .enumerate()

@@ -188,7 +188,7 @@ fn run_scenario_with(integrator: &str) -> (Result<(), String>, Vec<String>, Vec<
     let scenario = railmbs_models::parse_scenario(&text, &path).unwrap();
     let model = railmbs_models::load_model(&scenario.model).unwrap();
     let out = dir.path().join("out.csv");
-    let result = railmbs_runtime::simulate::run_scenario(
+    let result = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         Box::new(NumericEquations::new(&model)),

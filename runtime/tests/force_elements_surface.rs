@@ -123,8 +123,8 @@ fn planar_surface_equals_the_point_plane_contact() {
             v.iter_mut().for_each(|x| *x *= 1e-3);
         }
         // Modes and anchors from the same accepted state, then moved.
-        s1.accept_step(0.0, &q, &v);
-        s2.accept_step(0.0, &q, &v);
+        s1.accept_step(0.0, &q, &v).unwrap();
+        s2.accept_step(0.0, &q, &v).unwrap();
         let q: Vec<f64> = q.iter().map(|x| x + 2e-4).collect();
         let mut m = DMatrix::zeros(n, n);
         let (mut f1, mut f2) = (DVector::zeros(n), DVector::zeros(n));

@@ -5,7 +5,7 @@
 //! curve by its track-following frame.
 
 use railmbs_runtime::NumericEquations;
-use railmbs_runtime::simulate::run_scenario;
+use railmbs_runtime::run::run_scenario;
 
 /// Runs `scenario` (text) with `model` (text) written beside it; returns the
 /// header and rows of the output.

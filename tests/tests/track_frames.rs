@@ -161,7 +161,7 @@ fn tc1_free_body_error(tol: f64) -> (f64, usize) {
     let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("tc1.csv");
-    let summary = railmbs_runtime::simulate::run_scenario(
+    let summary = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         Box::new(NumericEquations::new(&model)),
@@ -214,7 +214,7 @@ fn a_free_body_on_manchester_track_case_1_goes_straight_in_sc0() {
         railmbs_models::load_scenario(&scenario_path).unwrap_or_else(|e| panic!("{e}"));
     let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     scenario.track = None;
-    let err = railmbs_runtime::simulate::run_scenario(
+    let err = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         Box::new(NumericEquations::new(&model)),
@@ -227,4 +227,28 @@ fn a_free_body_on_manchester_track_case_1_goes_straight_in_sc0() {
         err.contains("track_free_body_tc1.ron") && err.contains("track"),
         "{err}"
     );
+}
+
+#[test]
+fn a_run_into_a_table_holds_the_csv_columns_exactly() {
+    // The same run written to a CSV file and kept in memory: the table has
+    // the file's header and, column by column, its values (the CSV's
+    // shortest round-trip text parses back to the same f64).
+    let scenario_path = model_path("scenarios/track_free_body_tc1.ron");
+    let scenario = railmbs_models::load_scenario(&scenario_path).unwrap_or_else(|e| panic!("{e}"));
+    let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
+    let engine = || Box::new(NumericEquations::new(&model));
+    let csv = run_to_table(&scenario, &model, engine());
+    let mut table = railmbs_runtime::run::Table::new();
+    let summary =
+        railmbs_runtime::run::run_scenario_into(&scenario, &model, engine(), &mut table, |_| {})
+            .unwrap();
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    assert_eq!(summary.rows, csv.rows.len());
+    assert_eq!(table.names(), &csv.header[..]);
+    assert_eq!(table.rows(), csv.rows.len());
+    for name in &csv.header {
+        assert_eq!(table.column(name).unwrap(), &csv.col(name)[..], "{name}");
+    }
+    assert!(table.column("no such column").is_none());
 }

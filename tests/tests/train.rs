@@ -26,7 +26,7 @@ fn run(
     train: &TrainScenario,
     engine: impl Fn(&Model) -> Box<dyn Equations>,
     out: &Path,
-) -> (Table, railmbs_runtime::simulate::RunSummary) {
+) -> (Table, railmbs_runtime::run::RunSummary) {
     let models = vehicle_models(train);
     let refs: Vec<&Model> = models.iter().collect();
     let engines = models.iter().map(&engine).collect();
@@ -60,7 +60,7 @@ fn a_train_of_one_vehicle_runs_the_plain_scenario() {
     scenario.output.velocities = true;
     let model = load_model(&scenario.model).unwrap();
     let plain_out = dir.path().join("plain.csv");
-    let plain = railmbs_runtime::simulate::run_scenario(
+    let plain = railmbs_runtime::run::run_scenario(
         &scenario,
         &model,
         numeric(&model),

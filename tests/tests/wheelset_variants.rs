@@ -389,8 +389,7 @@ fn normal_damping_with_elastic_rails_is_refused() {
         railmbs_models::load_scenario(&model_path("scenarios/wheelset_elastic_rail_30.ron"))
             .unwrap();
     let engine = Box::new(NumericEquations::new(&model));
-    let err = match railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {})
-    {
+    let err = match railmbs_runtime::run::run_scenario(&scenario, &model, engine, None, |_| {}) {
         Err(e) => e.to_string(),
         Ok(summary) => format!("{:?}", summary.error),
     };
@@ -683,15 +682,14 @@ fn elastic_rails_balance_a_lateral_axle_force_on_the_flange_root() {
 fn run_with_jacobian(
     scenario: &str,
     kind: railmbs_models::JacobianKind,
-) -> railmbs_runtime::simulate::RunSummary {
+) -> railmbs_runtime::run::RunSummary {
     let mut scenario = railmbs_models::load_scenario(&model_path(scenario)).unwrap();
     if let IntegratorSpec::Park { jacobian, .. } = &mut scenario.integrator {
         *jacobian = kind;
     }
     let model = railmbs_models::load_model(&scenario.model).unwrap();
     let engine = Box::new(NumericEquations::new(&model));
-    let s =
-        railmbs_runtime::simulate::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
+    let s = railmbs_runtime::run::run_scenario(&scenario, &model, engine, None, |_| {}).unwrap();
     assert!(s.error.is_none(), "{:?}", s.error);
     s
 }

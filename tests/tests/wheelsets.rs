@@ -271,7 +271,7 @@ fn short_runs_judge_the_peaks() {
     let model = railmbs_models::load_model(&scenario.model).unwrap();
     let run = |scenario: &railmbs_models::Scenario| {
         let dir = tempfile::tempdir().unwrap();
-        let summary = railmbs_runtime::simulate::run_scenario(
+        let summary = railmbs_runtime::run::run_scenario(
             scenario,
             &model,
             Box::new(NumericEquations::new(&model)),

@@ -11,7 +11,6 @@ pub mod contact;
 mod linear6;
 pub mod nonlinear;
 mod series;
-pub mod sliding_mean;
 pub mod wheel_rail;
 
 pub use applied::AppliedForce;
@@ -72,6 +71,18 @@ pub struct ForceContext<'a> {
     pub state_rates: &'a [f64],
 }
 
+/// A wheelset's loads at an accepted state, for the assessment of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WheelLoads {
+    /// Distance of the wheelset along the track, m (`None` off a track).
+    pub distance: Option<f64>,
+    /// (Q, Y) per wheel (left, right): vertical load and lateral force on
+    /// the rail, positive towards the field side, N.
+    pub loads: [(f64, f64); 2],
+    /// Nadal's limit of Y/Q for the flange angle and friction, –.
+    pub nadal: Option<f64>,
+}
+
 /// A force element of the runtime.
 pub trait ForceElement: std::fmt::Debug + Send {
     /// Long name (as in the model).
@@ -98,10 +109,11 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn needs_track(&self) -> bool {
         false
     }
-    /// Safety and loading maxima over the accepted steps so far, for the
-    /// end-of-run summary.
-    fn assessment(&self) -> Vec<Assessment> {
-        Vec::new()
+    /// The wheel loads at an accepted state, for the EN 14363 assessment
+    /// of the run ([`crate::run::assessment`]); `None` for elements that are
+    /// not wheel–rail contacts.
+    fn assessment_loads(&self, _ctx: &ForceContext) -> Option<WheelLoads> {
+        None
     }
     /// Number of first-order state variables the element adds to the system
     /// (a spring in series with a damper: its spring extension). They are

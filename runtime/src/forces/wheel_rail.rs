@@ -65,7 +65,6 @@
 //! towards the field side, both in the track frame; ΣY the track-shifting force
 //! of the wheelset (lateral force on the track, positive to the left).
 
-use super::sliding_mean::SlidingMean;
 use super::{
     ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment, eval_scalar,
 };
@@ -353,11 +352,6 @@ pub struct WheelRailContact {
     spec: WheelRail,
     c: Constants,
     bound: Option<Bound>,
-    /// Running maxima over accepted steps, for the assessment summary.
-    maxima: Maxima,
-    /// 2 m sliding means of Y/Q and ΣY over the distance run (EN 14363)
-    /// and their maxima.
-    means: Option<Box<SlidingMeans>>,
     /// The last solved state and what it was solved for (time and the
     /// wheelset's kinematics): the accept-step hook, the outputs and the
     /// Jacobian usually ask again for the state the last force evaluation
@@ -372,75 +366,6 @@ pub struct WheelRailContact {
     rail_history: [Option<RailRecord>; RAIL_HISTORY],
     /// A valid Hertz shape for contacts without load (elastic rails).
     placeholder_shape: Option<HertzShape>,
-}
-
-/// Length of the sliding window of Y/Q and ΣY (EN 14363's 2 m), m.
-const ASSESSMENT_WINDOW: f64 = 2.0;
-
-/// The sliding means of the assessment over the distance run, and their
-/// maxima (value, time): robust against short spikes, whose raw peaks depend
-/// on how the step sequence samples them.
-#[derive(Debug, Clone)]
-struct SlidingMeans {
-    last_t: f64,
-    y_over_q: [SlidingMean; 2],
-    sum_y: SlidingMean,
-    max_y_over_q: [(f64, f64); 2],
-    max_sum_y: (f64, f64),
-}
-
-impl SlidingMeans {
-    fn new() -> Self {
-        Self {
-            last_t: f64::NEG_INFINITY,
-            y_over_q: [
-                SlidingMean::new(ASSESSMENT_WINDOW),
-                SlidingMean::new(ASSESSMENT_WINDOW),
-            ],
-            sum_y: SlidingMean::new(ASSESSMENT_WINDOW),
-            max_y_over_q: [(f64::NEG_INFINITY, f64::NAN); 2],
-            max_sum_y: (f64::NEG_INFINITY, f64::NAN),
-        }
-    }
-
-    /// Adds an accepted step at time `t` (s) and distance `s` (m) with the
-    /// wheel loads (Q, Y) per side (N); a time before the last starts over
-    /// (a new run).
-    fn push(&mut self, t: f64, s: f64, loads: &[(f64, f64); 2]) {
-        if t < self.last_t {
-            *self = Self::new();
-        }
-        self.last_t = t;
-        for (side, &(q, y)) in loads.iter().enumerate() {
-            let ratio = if q > 0.0 { y / q } else { 0.0 };
-            if let Some(v) = self.y_over_q[side].push(s, ratio)
-                && v > self.max_y_over_q[side].0
-            {
-                self.max_y_over_q[side] = (v, t);
-            }
-        }
-        if let Some(v) = self.sum_y.push(s, loads[0].1 - loads[1].1)
-            && v.abs() > self.max_sum_y.0
-        {
-            self.max_sum_y = (v.abs(), t);
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, Default)]
-struct Maxima {
-    /// max Y/Q per side and the time.
-    y_over_q: [(f64, f64); 2],
-    /// max |ΣY| (N) and the time.
-    sum_y: (f64, f64),
-    /// max Q per side (N) and the time.
-    q: [(f64, f64); 2],
-    /// min Q per side (N) and the time: wheel unloading, 0 when it lifts.
-    q_min: [(f64, f64); 2],
-    /// Σ (Q_left + Q_right) over accepted steps and their count: the mean axle
-    /// load for Prud'homme's limit.
-    axle_load_sum: f64,
-    samples: usize,
 }
 
 impl std::fmt::Debug for WheelRailContact {
@@ -460,8 +385,6 @@ impl WheelRailContact {
             spec: spec.clone(),
             c: Constants::default(),
             bound: None,
-            maxima: Maxima::default(),
-            means: None,
             last: std::sync::Mutex::new(None),
             rail_history: [None; RAIL_HISTORY],
             placeholder_shape: HertzShape::with_modulus(1.0, 1.0, 1.0).ok(),
@@ -1250,37 +1173,22 @@ impl ForceElement for WheelRailContact {
         }
     }
 
-    fn accept_step(&mut self, ctx: &ForceContext) {
-        let Ok(state) = self.solve(ctx) else { return };
-        let loads = Self::wheel_loads(&state);
-        let m = &mut self.maxima;
-        for (side, &(q, y)) in loads.iter().enumerate() {
-            if q > 0.0 && y / q > m.y_over_q[side].0 {
-                m.y_over_q[side] = (y / q, ctx.t);
-            }
-            if q > m.q[side].0 {
-                m.q[side] = (q, ctx.t);
-            }
-            if m.samples == 0 || q < m.q_min[side].0 {
-                m.q_min[side] = (q, ctx.t);
-            }
-        }
-        let sum_y = (loads[0].1 - loads[1].1).abs();
-        if sum_y > m.sum_y.0 {
-            m.sum_y = (sum_y, ctx.t);
-        }
-        m.axle_load_sum += loads[0].0 + loads[1].0;
-        m.samples += 1;
-        // Sliding means over the distance s of the wheelset.
-        let s = self
+    fn assessment_loads(&self, ctx: &ForceContext) -> Option<super::WheelLoads> {
+        let state = self.solve(ctx).ok()?;
+        // The distance s of the wheelset along the track.
+        let distance = self
             .bound
             .as_ref()
             .and_then(|b| b.speed.motion(ctx.t).ok().map(|m| m.s + b.offset));
-        if let Some(s) = s {
-            self.means
-                .get_or_insert_with(|| Box::new(SlidingMeans::new()))
-                .push(ctx.t, s, &loads);
-        }
+        Some(super::WheelLoads {
+            distance,
+            loads: Self::wheel_loads(&state),
+            nadal: self.bound.as_ref().map(|b| b.nadal),
+        })
+    }
+
+    fn accept_step(&mut self, ctx: &ForceContext) {
+        let Ok(state) = self.solve(ctx) else { return };
         // Elastic rails: this step's rail displacements become the start of
         // the next step's damper rate (never changed inside Newton
         // iterations or by rejected steps).
@@ -1300,62 +1208,6 @@ impl ForceElement for WheelRailContact {
                 }
             }
         }
-    }
-
-    fn assessment(&self) -> Vec<super::Assessment> {
-        let m = &self.maxima;
-        if m.samples == 0 {
-            return Vec::new();
-        }
-        let nadal = self.bound.as_ref().map(|b| b.nadal);
-        let axle = m.axle_load_sum / m.samples as f64;
-        // EN 14363 judges Y/Q and ΣY as 2 m sliding means; the raw peaks are
-        // listed too, without a limit (a spike's sampled peak depends on the
-        // step sequence) — except when the run was shorter than the window:
-        // then the peaks are judged. Where a wheel lifts (Q = 0) its Y/Q
-        // counts as 0 in the mean; the minimum Q rows show the lift.
-        let row = |quantity: String,
-                   (max, time): (f64, f64),
-                   limit: Option<(Option<f64>, &'static str)>,
-                   unit: &'static str| super::Assessment {
-            element: self.name.clone(),
-            quantity,
-            max,
-            time,
-            limit: limit.and_then(|l| l.0),
-            limit_name: limit.map_or("", |l| l.1),
-            unit,
-        };
-        let mut rows = Vec::new();
-        let means = self.means.as_deref();
-        let nadal = Some((nadal, "Nadal"));
-        let prudhomme = Some((Some(prudhomme_limit(axle)), "Prud'homme"));
-        for (side, label) in [(0, "left"), (1, "right")] {
-            let mean = means
-                .map(|mm| mm.max_y_over_q[side])
-                .filter(|v| v.0.is_finite());
-            if let Some(v) = mean {
-                rows.push(row(format!("Y/Q {label} (2 m)"), v, nadal, "-"));
-            }
-            let peak_limit = if mean.is_some() { None } else { nadal };
-            rows.push(row(
-                format!("Y/Q {label} peak"),
-                m.y_over_q[side],
-                peak_limit,
-                "-",
-            ));
-        }
-        let mean = means.map(|mm| mm.max_sum_y).filter(|v| v.0.is_finite());
-        if let Some(v) = mean {
-            rows.push(row("|ΣY| (2 m)".into(), v, prudhomme, "N"));
-        }
-        let peak_limit = if mean.is_some() { None } else { prudhomme };
-        rows.push(row("|ΣY| peak".into(), m.sum_y, peak_limit, "N"));
-        for (side, label) in [(0, "left"), (1, "right")] {
-            rows.push(row(format!("Q {label}"), m.q[side], None, "N"));
-            rows.push(row(format!("Q {label} min"), m.q_min[side], None, "N"));
-        }
-        rows
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {

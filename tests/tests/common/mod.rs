@@ -258,8 +258,7 @@ pub fn run_to_table(
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.csv");
     let summary =
-        railmbs_runtime::simulate::run_scenario(scenario, model, engine, Some(&out), |_| {})
-            .unwrap();
+        railmbs_runtime::run::run_scenario(scenario, model, engine, Some(&out), |_| {}).unwrap();
     assert!(summary.error.is_none(), "{:?}", summary.error);
     assert!((summary.t_end - scenario.end_time).abs() < 1e-9);
     Table::read(&out)

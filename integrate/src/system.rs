@@ -7,7 +7,8 @@
 //! ```
 //!
 //! with f = Q − k (applied generalized forces minus inertia/velocity terms).
-//! The integrators in [`crate::integrate`] know nothing else about the model.
+//! The integrators ([`crate::park`], [`crate::rk4`]) know nothing else about
+//! the model.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -16,11 +17,21 @@ use nalgebra::{DMatrix, DVector};
 pub enum SimError {
     /// A non-finite number appeared in the equations.
     #[error("non-finite value at t = {t} s: {what}")]
-    NonFinite { t: f64, what: String },
+    NonFinite {
+        /// Time, s.
+        t: f64,
+        /// The quantity and the offending entry.
+        what: String,
+    },
     /// The integrator could not continue (Newton failure at the minimum step,
     /// step size underflow, singular iteration matrix...).
     #[error("simulation diverged at t = {t} s: {reason}")]
-    Diverged { t: f64, reason: String },
+    Diverged {
+        /// Time, s.
+        t: f64,
+        /// Why.
+        reason: String,
+    },
     /// Anything else with a message (bad settings, a force element's complaint).
     #[error("{0}")]
     Other(String),
@@ -90,5 +101,60 @@ pub trait MechanicalSystem {
 
     /// Called once for every accepted step with its final state. Force elements
     /// with state (stick anchors, friction modes) update here and only here.
-    fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) {}
+    /// An error ends the integration (the solver's `step` returns it).
+    fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) -> Result<(), SimError> {
+        Ok(())
+    }
+}
+
+/// A mutable reference integrates as the system itself (a solver can then
+/// borrow the system instead of owning it).
+impl<S: MechanicalSystem + ?Sized> MechanicalSystem for &mut S {
+    fn dof(&self) -> usize {
+        (**self).dof()
+    }
+
+    fn is_first_order(&self, i: usize) -> bool {
+        (**self).is_first_order(i)
+    }
+
+    fn n_constraints(&self) -> usize {
+        (**self).n_constraints()
+    }
+
+    fn dynamics(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        (**self).dynamics(t, q, v, mass, force)
+    }
+
+    fn constraints(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        g: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), SimError> {
+        (**self).constraints(t, q, g, jacobian)
+    }
+
+    fn force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut DMatrix<f64>,
+        dfdv: &mut DMatrix<f64>,
+    ) -> Result<bool, SimError> {
+        (**self).force_jacobian(t, q, v, dfdq, dfdv)
+    }
+
+    fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
+        (**self).accept_step(t, q, v)
+    }
 }

@@ -66,13 +66,13 @@
 //! rejected; the step size follows `h·0.9·err^(−1/(p+1))`, limited to
 //! [0.2, 1.6]·h, kept unchanged when the factor lies in [1, 1.2] (to reuse the
 //! factorization), capped by `max_step`, and the last steps are adjusted to
-//! end exactly at `t_end`.
+//! end exactly at the stop time ([`Stepper::set_stop_time`]).
 //!
 //! Velocities of coordinates that appear in the constraints are index-2
 //! variables of the index-3 system: their error enters the norm multiplied by
 //! min(h, 1) (Hairer & Wanner's RADAU5 scaling), otherwise the Newton error
 //! δq/β in v would drive the step size down without end. The last steps
-//! approach `t_end` in at most five equal steps.
+//! approach the stop time in at most five equal steps.
 //!
 //! # Accuracy of accelerations and multipliers (constrained systems)
 //!
@@ -100,7 +100,10 @@ use std::ops::ControlFlow;
 use nalgebra::{Cholesky, DMatrix, DVector};
 
 use super::linalg::DenseLu;
-use super::{IntegrationStats, StepView, check_finite, check_run_arguments};
+use super::{
+    IntegrationStats, StepView, Stepper, at_stop_time, check_end_time, check_finite,
+    check_initial_state, check_stop_time,
+};
 use crate::system::{MechanicalSystem, SimError};
 
 /// How the Jacobians ∂f/∂q and ∂f/∂q̇ of the iteration matrix are obtained.
@@ -137,7 +140,7 @@ pub struct ParkSettings {
     /// Source of ∂f/∂q and ∂f/∂q̇.
     pub jacobian: JacobianKind,
     /// Constant step `initial_step` without error control (the last step is
-    /// shortened to hit `t_end`); rtol/atol then only set the Newton accuracy.
+    /// shortened to hit the stop time); rtol/atol then only set the Newton accuracy.
     /// Meant for convergence studies.
     pub fixed_step: bool,
     /// Newton iterations per step attempt before the attempt fails (≥ 1).
@@ -1035,21 +1038,97 @@ fn bdf_weights(s: &[f64], c: &mut [f64]) {
     }
 }
 
-/// Park's implicit integrator with its workspaces (reusable across runs of
-/// systems of the same size without reallocating).
+/// Park's implicit method stepping one system ([`Stepper`]): the system,
+/// the settings, the workspaces and the step-size controller's state.
 #[derive(Debug)]
-pub struct Park {
+pub struct Park<S> {
+    system: S,
     settings: ParkSettings,
     work: Work,
+    stats: IntegrationStats,
+    /// Start time (fixed steps end at t0 + k·h), s.
+    t0: f64,
+    /// Current time, s.
+    t: f64,
+    /// Stop time, s.
+    t_stop: f64,
+    /// Length of the last accepted step, s (0 before the first).
+    h_last: f64,
+    /// Proposed next step, s; `None` until the first step chooses it.
+    h: Option<f64>,
+    kappa: f64,
+    eta: f64,
+    need_jacobian: bool,
+    jacobian_fresh: bool,
+    /// β of the current factorization (NaN: none usable).
+    beta_lu: f64,
+    rejected_last: bool,
+    /// Consecutive rejections of the current step. After a discontinuity in
+    /// the forcing (a kink in the track's curvature, a friction mode
+    /// change) the history polynomial spans the jump and its error estimate
+    /// no longer falls with the step: restart from the current point with
+    /// the one-step BDF1 (the start-up sequence builds the history again).
+    consecutive_rejections: usize,
 }
 
-impl Park {
-    /// An integrator with the given settings.
-    pub fn new(settings: ParkSettings) -> Self {
-        Self {
-            settings,
-            work: Work::new(0, 0),
+impl<S: MechanicalSystem> Park<S> {
+    /// A solver for `system` at `(t0, q0, v0)` (s, and the coordinates'
+    /// units) with `settings`.
+    ///
+    /// For constrained systems q0 and v0 are first made consistent (see the
+    /// module documentation); the initial accelerations and multipliers are
+    /// computed here ([`Stepper::state`] shows them).
+    ///
+    /// # Errors
+    /// [`SimError::Other`] for bad settings or state sizes, or constraints
+    /// that cannot be satisfied initially; [`SimError::NonFinite`] with the
+    /// time when a NaN or infinity appears in M, f, g, G or the state; and any
+    /// error of the system itself. [`Stepper::step`] fails the same way, and
+    /// with [`SimError::Diverged`] (time and reason) when the step would fall
+    /// below `min_step` (or Newton fails at a fixed step).
+    pub fn new(
+        mut system: S,
+        settings: ParkSettings,
+        t0: f64,
+        q0: &[f64],
+        v0: &[f64],
+    ) -> Result<Self, SimError> {
+        settings.validate()?;
+        let n = system.dof();
+        let nc = system.n_constraints();
+        check_initial_state(n, t0, q0, v0)?;
+        let mut w = Work::new(n, nc);
+        let mut st = IntegrationStats::new(t0, n, nc);
+        // Consistent initial state, accelerations and multipliers.
+        w.q.copy_from_slice(q0);
+        w.v.copy_from_slice(v0);
+        if nc > 0 {
+            w.project_initial(&mut system, t0)?;
         }
+        w.consistent_acceleration(&mut system, t0, &mut st)?;
+        w.hlen = 0;
+        w.push_history(t0);
+        let h = settings.initial_step.map(|h| h.min(settings.max_step));
+        let mut solver = Self {
+            system,
+            kappa: settings.newton_kappa(),
+            settings,
+            work: w,
+            stats: st,
+            t0,
+            t: t0,
+            t_stop: f64::INFINITY,
+            h_last: 0.0,
+            h,
+            eta: 1.0,
+            need_jacobian: true,
+            jacobian_fresh: false,
+            beta_lu: f64::NAN,
+            rejected_last: false,
+            consecutive_rejections: 0,
+        };
+        solver.record_state();
+        Ok(solver)
     }
 
     /// The settings.
@@ -1057,109 +1136,71 @@ impl Park {
         &self.settings
     }
 
-    /// Integrates from `(t0, q0, v0)` to `t_end` (reached exactly).
-    ///
-    /// For constrained systems q0 and v0 are first made consistent (see the
-    /// module documentation). `observer` gets a [`StepView`] of the initial
-    /// state and then of the end of every accepted step (with the multipliers
-    /// λ), and may stop the run with `ControlFlow::Break`.
-    /// [`MechanicalSystem::accept_step`] is called once per accepted step,
-    /// before the observer.
-    ///
-    /// # Errors
-    /// [`SimError::Other`] for bad settings or state sizes, or constraints
-    /// that cannot be satisfied initially; [`SimError::NonFinite`] with the
-    /// time when a NaN or infinity appears in M, f, g, G or the state;
-    /// [`SimError::Diverged`] with the time and the reason when the step would
-    /// fall below `min_step` (or Newton fails at a fixed step); and any error
-    /// of the system itself.
-    pub fn run<S, F>(
-        &mut self,
-        system: &mut S,
-        t0: f64,
-        q0: &[f64],
-        v0: &[f64],
-        t_end: f64,
-        mut observer: F,
-    ) -> Result<IntegrationStats, SimError>
-    where
-        S: MechanicalSystem + ?Sized,
-        F: FnMut(&StepView<'_>) -> ControlFlow<()>,
-    {
-        self.settings.validate()?;
-        let s = self.settings.clone();
-        let n = system.dof();
-        let nc = system.n_constraints();
-        check_run_arguments(n, t0, q0, v0, t_end)?;
-        if self.work.n != n || self.work.nc != nc {
-            self.work = Work::new(n, nc);
+    /// Copies the current state into the statistics.
+    fn record_state(&mut self) {
+        let (w, st) = (&self.work, &mut self.stats);
+        st.t = self.t;
+        st.q.copy_from(&w.hq[0]);
+        st.v.copy_from(&w.hv[0]);
+        st.accel.copy_from(&w.ha[0]);
+        st.lambda.copy_from(&w.lambda);
+    }
+}
+
+impl<S: MechanicalSystem> Stepper for Park<S> {
+    type System = S;
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn state(&self) -> StepView<'_> {
+        let w = &self.work;
+        StepView {
+            t: self.t,
+            h: self.h_last,
+            q: w.hq[0].as_slice(),
+            v: w.hv[0].as_slice(),
+            accel: w.ha[0].as_slice(),
+            lambda: w.lambda.as_slice(),
         }
+    }
+
+    fn set_stop_time(&mut self, t_stop: f64) -> Result<(), SimError> {
+        check_stop_time(self.t, t_stop)?;
+        self.t_stop = t_stop;
+        Ok(())
+    }
+
+    fn stop_time(&self) -> f64 {
+        self.t_stop
+    }
+
+    /// One accepted step of Park's method: Newton iterations on the
+    /// corrector, the local error test, rejected attempts retried with a
+    /// smaller step (or a fresh Jacobian) until one is accepted.
+    /// [`MechanicalSystem::accept_step`] is called once with its state.
+    fn step(&mut self) -> Result<StepView<'_>, SimError> {
+        let s = &self.settings;
+        let (t, t_end, t0) = (self.t, self.t_stop, self.t0);
+        if t >= t_end {
+            return Err(at_stop_time(t));
+        }
+        let n = self.work.n;
+        let nc = self.work.nc;
         let w = &mut self.work;
-        w.analytic_ok = true;
-        w.constrained.fill(false);
-        w.lu.resize(n + nc);
-        w.lu_kkt.resize(n + nc);
-        let mut st = IntegrationStats::new(t0, n, nc);
-
-        // Consistent initial state, accelerations and multipliers.
-        w.q.copy_from_slice(q0);
-        w.v.copy_from_slice(v0);
-        if nc > 0 {
-            w.project_initial(system, t0)?;
-        }
-        w.consistent_acceleration(system, t0, &mut st)?;
-        w.hlen = 0;
-        w.push_history(t0);
-
-        let report = |w: &Work, observer: &mut F, t: f64, h: f64| {
-            observer(&StepView {
-                t,
-                h,
-                q: w.hq[0].as_slice(),
-                v: w.hv[0].as_slice(),
-                accel: w.ha[0].as_slice(),
-                lambda: w.lambda.as_slice(),
-            })
-            .is_break()
+        let st = &mut self.stats;
+        let system = &mut self.system;
+        let mut h = match self.h {
+            Some(h) => h,
+            None => w.initial_step(system, t0, t_end - t0, s, st)?,
         };
-        let finish = |w: &Work, st: &mut IntegrationStats, t: f64| {
-            st.t = t;
-            st.q.copy_from(&w.hq[0]);
-            st.v.copy_from(&w.hv[0]);
-            st.accel.copy_from(&w.ha[0]);
-            st.lambda.copy_from(&w.lambda);
-        };
-        if report(w, &mut observer, t0, 0.0) {
-            st.stopped_by_observer = true;
-            finish(w, &mut st, t0);
-            return Ok(st);
-        }
-
-        let mut t = t0;
-        let mut h = match s.initial_step {
-            Some(h) => h.min(s.max_step),
-            None if t_end > t0 => w.initial_step(system, t0, t_end - t0, &s, &mut st)?,
-            None => 0.0,
-        };
-        let kappa = s.newton_kappa();
-        let mut eta: f64 = 1.0;
-        let mut need_jacobian = true;
-        let mut jacobian_fresh = false;
-        let mut beta_lu = f64::NAN;
-        let mut rejected_last = false;
-        // Consecutive rejections of the current step. After a discontinuity in
-        // the forcing (a kink in the track's curvature, a friction mode
-        // change) the history polynomial spans the jump and its error estimate
-        // no longer falls with the step: restart from the current point with
-        // the one-step BDF1 (the start-up sequence builds the history again).
-        let mut consecutive_rejections = 0usize;
-
-        while t < t_end {
-            if consecutive_rejections >= RESTART_AFTER_REJECTIONS && w.hlen > 1 {
+        loop {
+            if self.consecutive_rejections >= RESTART_AFTER_REJECTIONS && w.hlen > 1 {
                 w.hlen = 1;
-                consecutive_rejections = 0;
-                need_jacobian = true;
-                beta_lu = f64::NAN;
+                self.consecutive_rejections = 0;
+                self.need_jacobian = true;
+                self.beta_lu = f64::NAN;
             }
             // Step length, ending exactly at t_end and avoiding a sliver.
             let remaining = t_end - t;
@@ -1200,25 +1241,25 @@ impl Park {
             for i in 0..n {
                 w.wq[i] = s.atol + s.rtol * w.hq[0][i].abs();
             }
-            if need_jacobian {
+            if self.need_jacobian {
                 w.derivatives_from_q(beta);
-                w.evaluate_jacobian(system, s.jacobian, t_new, &mut st)?;
-                need_jacobian = false;
-                jacobian_fresh = true;
-                beta_lu = f64::NAN;
+                w.evaluate_jacobian(system, s.jacobian, t_new, st)?;
+                self.need_jacobian = false;
+                self.jacobian_fresh = true;
+                self.beta_lu = f64::NAN;
             }
             let mut singular = false;
             // (A NaN beta_lu, no usable factorization, also refactorizes.)
-            let stale = ((beta / beta_lu) - 1.0).abs();
+            let stale = ((beta / self.beta_lu) - 1.0).abs();
             if stale.is_nan() || stale > REFACTOR_RATIO {
-                if w.factor_iteration_matrix(beta, &mut st) {
-                    beta_lu = beta;
+                if w.factor_iteration_matrix(beta, st) {
+                    self.beta_lu = beta;
                 } else {
-                    beta_lu = f64::NAN;
+                    self.beta_lu = f64::NAN;
                     singular = true;
                 }
             }
-            eta = eta.max(f64::EPSILON).powf(0.8);
+            self.eta = self.eta.max(f64::EPSILON).powf(0.8);
             let outcome = if singular {
                 Newton::Failed("iteration matrix is singular".into())
             } else {
@@ -1226,10 +1267,10 @@ impl Park {
                     system,
                     t_new,
                     beta,
-                    kappa,
+                    self.kappa,
                     s.max_newton_iterations,
-                    &mut eta,
-                    &mut st,
+                    &mut self.eta,
+                    st,
                 )?
             };
             let (iterations, theta_max) = match outcome {
@@ -1240,16 +1281,16 @@ impl Park {
                 Newton::Failed(reason) => {
                     st.rejected_steps += 1;
                     st.newton_failures += 1;
-                    consecutive_rejections += 1;
-                    eta = 1.0;
-                    if !singular && beta_lu != beta {
+                    self.consecutive_rejections += 1;
+                    self.eta = 1.0;
+                    if !singular && self.beta_lu != beta {
                         // First retry: factorize for the exact β (cheap).
-                        beta_lu = f64::NAN;
+                        self.beta_lu = f64::NAN;
                         continue;
                     }
-                    if !jacobian_fresh {
+                    if !self.jacobian_fresh {
                         // Retry the same step with a new Jacobian.
-                        need_jacobian = true;
+                        self.need_jacobian = true;
                         continue;
                     }
                     if s.fixed_step {
@@ -1268,7 +1309,7 @@ impl Park {
                             ),
                         });
                     }
-                    rejected_last = true;
+                    self.rejected_last = true;
                     continue;
                 }
             };
@@ -1290,9 +1331,9 @@ impl Park {
                 }
                 if err > 1.0 {
                     st.rejected_steps += 1;
-                    consecutive_rejections += 1;
+                    self.consecutive_rejections += 1;
                     h = hs * (SAFETY * err.powf(exponent)).clamp(FAC_MIN, 1.0);
-                    rejected_last = true;
+                    self.rejected_last = true;
                     if h < s.min_step {
                         return Err(SimError::Diverged {
                             t,
@@ -1316,32 +1357,27 @@ impl Park {
             }
 
             // Accept.
-            consecutive_rejections = 0;
+            self.consecutive_rejections = 0;
             w.push_history(t_new);
-            t = t_new;
             if s.consistent_multipliers && nc > 0 {
                 // w.q, w.v hold the accepted state; replace the reported
                 // (and only reported: ha is used by the start-up predictor
                 // alone) accelerations and multipliers.
-                w.consistent_acceleration(system, t, &mut st)?;
+                w.consistent_acceleration(system, t_new, st)?;
                 w.ha[0].copy_from(&w.a);
                 w.lambda.copy_from(&w.lam);
             }
             st.steps += 1;
-            system.accept_step(t, w.hq[0].as_slice(), w.hv[0].as_slice());
-            if report(w, &mut observer, t, hs) {
-                st.stopped_by_observer = true;
-                break;
-            }
+            system.accept_step(t_new, w.hq[0].as_slice(), w.hv[0].as_slice())?;
             if iterations >= 6 || theta_max > 0.2 {
-                need_jacobian = true; // slow convergence: refresh for the next step
+                self.need_jacobian = true; // slow convergence: refresh for the next step
             }
-            jacobian_fresh = false;
+            self.jacobian_fresh = false;
             if !s.fixed_step {
-                if rejected_last {
+                if self.rejected_last {
                     fac = fac.min(1.0);
                 }
-                rejected_last = false;
+                self.rejected_last = false;
                 h = if (1.0..=HOLD_MAX).contains(&fac) {
                     hs
                 } else {
@@ -1349,16 +1385,64 @@ impl Park {
                 };
                 h = h.min(s.max_step).max(s.min_step);
             }
+            self.h = Some(h);
+            self.t = t_new;
+            self.h_last = hs;
+            self.record_state();
+            return Ok(self.state());
         }
-        finish(w, &mut st, t);
-        Ok(st)
+    }
+
+    fn stats(&self) -> &IntegrationStats {
+        &self.stats
+    }
+
+    fn system(&self) -> &S {
+        &self.system
+    }
+
+    fn system_mut(&mut self) -> &mut S {
+        &mut self.system
     }
 }
 
-/// Integrates with Park's method from `(t0, q0, v0)` to `t_end`, calling
-/// `observer(t, q, v, q̈)` at `t0` and after every accepted step. A shorthand
-/// for [`Park::run`] (see there for errors and the constraint handling);
-/// use [`Park::run`] to also see the multipliers and step sizes.
+/// Integrates with Park's method from `(t0, q0, v0)` to `t_end` (reached
+/// exactly), calling `observer` with a [`StepView`] of the initial state and
+/// of the end of every accepted step: a loop over [`Park`]'s
+/// [`Stepper::step`] (see there and [`Park::new`] for the errors and the
+/// constraint handling). `observer` may stop the run with
+/// `ControlFlow::Break`; [`MechanicalSystem::accept_step`] is called once per
+/// accepted step, before the observer.
+pub fn integrate_park_steps<S, F>(
+    system: &mut S,
+    settings: &ParkSettings,
+    t0: f64,
+    q0: &[f64],
+    v0: &[f64],
+    t_end: f64,
+    mut observer: F,
+) -> Result<IntegrationStats, SimError>
+where
+    S: MechanicalSystem + ?Sized,
+    F: FnMut(&StepView<'_>) -> ControlFlow<()>,
+{
+    check_end_time(t0, t_end)?;
+    let mut solver = Park::new(system, settings.clone(), t0, q0, v0)?;
+    solver.set_stop_time(t_end)?;
+    loop {
+        if observer(&solver.state()).is_break() {
+            let mut stats = solver.stats().clone();
+            stats.stopped_by_observer = true;
+            return Ok(stats);
+        }
+        if solver.t() >= t_end {
+            return Ok(solver.stats().clone());
+        }
+        solver.step()?;
+    }
+}
+
+/// [`integrate_park_steps`] with an observer of `(t, q, v, q̈)`.
 pub fn integrate_park<S, F>(
     system: &mut S,
     settings: &ParkSettings,
@@ -1372,7 +1456,7 @@ where
     S: MechanicalSystem + ?Sized,
     F: FnMut(f64, &[f64], &[f64], &[f64]) -> ControlFlow<()>,
 {
-    Park::new(settings.clone()).run(system, t0, q0, v0, t_end, |s| {
+    integrate_park_steps(system, settings, t0, q0, v0, t_end, |s| {
         observer(s.t, s.q, s.v, s.accel)
     })
 }

@@ -37,14 +37,6 @@ impl DenseLu {
         self.piv.len()
     }
 
-    /// Resize for an `n × n` system (allocates only when n changes).
-    pub(crate) fn resize(&mut self, n: usize) {
-        if self.dim() != n {
-            *self = Self::new(n);
-        }
-        self.valid = false;
-    }
-
     /// Whether a successful factorization is stored.
     #[cfg(test)]
     pub(crate) fn is_valid(&self) -> bool {

@@ -8,10 +8,11 @@ use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 use nalgebra::{DMatrix, DVector};
-use railmbs_runtime::integrate::{
-    JacobianKind, Park, ParkSettings, Rk4Settings, integrate_park, integrate_rk4,
+use railmbs_integrate::{
+    JacobianKind, Park, ParkSettings, Rk4, Rk4Settings, Stepper, integrate_park,
+    integrate_park_steps, integrate_rk4,
 };
-use railmbs_runtime::{MechanicalSystem, SimError};
+use railmbs_integrate::{MechanicalSystem, SimError};
 
 // ---------------------------------------------------------------------------
 // Allocation counting (per thread, so parallel tests do not interfere)
@@ -108,8 +109,9 @@ impl MechanicalSystem for Oscillator {
         dfdv[(0, 0)] = -self.c;
         Ok(true)
     }
-    fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) {
+    fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) -> Result<(), SimError> {
         self.accepted += 1;
+        Ok(())
     }
 }
 
@@ -446,11 +448,7 @@ fn jacobian_kinds_agree_and_analytic_saves_evaluations() {
     }
     // Per Jacobian: forward differences cost 1 + 2n dynamics evaluations,
     // central 1 + 4n, analytic 1 (n = 1 here).
-    let per_jac = |r: &(
-        JacobianKind,
-        f64,
-        railmbs_runtime::integrate::IntegrationStats,
-    )| {
+    let per_jac = |r: &(JacobianKind, f64, railmbs_integrate::IntegrationStats)| {
         r.2.dynamics_evaluations - r.2.newton_iterations - 2 // start: a0 and the initial-step probe
     };
     assert_eq!(per_jac(&results[0]), 3 * results[0].2.jacobian_evaluations);
@@ -756,11 +754,7 @@ fn run_pendulum(
     theta0: f64,
     tol: f64,
     t_end: f64,
-) -> (
-    Pendulum,
-    Vec<Sample>,
-    railmbs_runtime::integrate::IntegrationStats,
-) {
+) -> (Pendulum, Vec<Sample>, railmbs_integrate::IntegrationStats) {
     let mut p = Pendulum {
         m: 3.0,
         l: 1.2,
@@ -768,18 +762,17 @@ fn run_pendulum(
     };
     let q0 = [p.l * theta0.sin(), -p.l * theta0.cos()];
     let mut samples = Vec::new();
-    let mut park = Park::new(ParkSettings::with_tolerances(tol, tol));
-    let st = park
-        .run(&mut p, 0.0, &q0, &[0.0, 0.0], t_end, |s| {
-            samples.push(Sample {
-                t: s.t,
-                q: [s.q[0], s.q[1]],
-                v: [s.v[0], s.v[1]],
-                lambda: s.lambda[0],
-            });
-            ControlFlow::Continue(())
-        })
-        .unwrap();
+    let settings = ParkSettings::with_tolerances(tol, tol);
+    let st = integrate_park_steps(&mut p, &settings, 0.0, &q0, &[0.0, 0.0], t_end, |s| {
+        samples.push(Sample {
+            t: s.t,
+            q: [s.q[0], s.q[1]],
+            v: [s.v[0], s.v[1]],
+            lambda: s.lambda[0],
+        });
+        ControlFlow::Continue(())
+    })
+    .unwrap();
     (p, samples, st)
 }
 
@@ -872,20 +865,19 @@ fn consistent_multipliers_equal_the_rod_tension_of_the_state() {
     };
     let mut worst = 0.0_f64;
     let mut worst_accel = 0.0_f64;
-    let st = Park::new(settings)
-        .run(&mut p, 0.0, &q0, &[0.0, 0.0], 3.0, |s| {
-            let (x, y, vx, vy) = (s.q[0], s.q[1], s.v[0], s.v[1]);
-            let tension = m * (g * (-y / l) + (vx * vx + vy * vy) / l);
-            worst = worst.max((-2.0 * l * s.lambda[0] - tension).abs());
-            // Newton's law for the mass: m a = (0, −m g) − T (x, y)/l.
-            let ax = -tension * x / (l * m);
-            let ay = -g - tension * y / (l * m);
-            worst_accel = worst_accel
-                .max((s.accel[0] - ax).abs())
-                .max((s.accel[1] - ay).abs());
-            ControlFlow::Continue(())
-        })
-        .unwrap();
+    let st = integrate_park_steps(&mut p, &settings, 0.0, &q0, &[0.0, 0.0], 3.0, |s| {
+        let (x, y, vx, vy) = (s.q[0], s.q[1], s.v[0], s.v[1]);
+        let tension = m * (g * (-y / l) + (vx * vx + vy * vy) / l);
+        worst = worst.max((-2.0 * l * s.lambda[0] - tension).abs());
+        // Newton's law for the mass: m a = (0, −m g) − T (x, y)/l.
+        let ax = -tension * x / (l * m);
+        let ay = -g - tension * y / (l * m);
+        worst_accel = worst_accel
+            .max((s.accel[0] - ax).abs())
+            .max((s.accel[1] - ay).abs());
+        ControlFlow::Continue(())
+    })
+    .unwrap();
     println!("consistent multipliers: tension {worst:e} N, accel {worst_accel:e}, {st:?}");
     assert!(worst < 1e-6 * m * g, "tension error {worst}");
     assert!(worst_accel < 1e-6 * g, "acceleration error {worst_accel}");
@@ -903,14 +895,21 @@ fn pendulum_multiplier_converges_with_order_two_at_fixed_step() {
         let q0 = [p.l * theta0.sin(), -p.l * theta0.cos()];
         let (m, l, g) = (p.m, p.l, p.g);
         let mut worst = 0.0_f64;
-        Park::new(ParkSettings::fixed(h))
-            .run(&mut p, 0.0, &q0, &[0.0, 0.0], 2.5, |s| {
+        integrate_park_steps(
+            &mut p,
+            &ParkSettings::fixed(h),
+            0.0,
+            &q0,
+            &[0.0, 0.0],
+            2.5,
+            |s| {
                 let (y, vx, vy) = (s.q[1], s.v[0], s.v[1]);
                 let tension = m * (g * (-y / l) + (vx * vx + vy * vy) / l);
                 worst = worst.max((-2.0 * l * s.lambda[0] - tension).abs());
                 ControlFlow::Continue(())
-            })
-            .unwrap();
+            },
+        )
+        .unwrap();
         worst
     };
     let (e1, e2) = (worst(2e-3), worst(1e-3));
@@ -929,14 +928,21 @@ fn inconsistent_pendulum_start_is_projected_onto_the_constraints() {
     };
     // Start 10 % too long and with a velocity component along the rod.
     let mut first = None;
-    let st = Park::new(ParkSettings::default())
-        .run(&mut p, 0.0, &[0.6, -0.9], &[0.3, 0.5], 0.1, |s| {
+    let st = integrate_park_steps(
+        &mut p,
+        &ParkSettings::default(),
+        0.0,
+        &[0.6, -0.9],
+        &[0.3, 0.5],
+        0.1,
+        |s| {
             if first.is_none() {
                 first = Some((s.q.to_vec(), s.v.to_vec(), s.lambda[0]));
             }
             ControlFlow::Continue(())
-        })
-        .unwrap();
+        },
+    )
+    .unwrap();
     let (q, v, lambda) = first.unwrap();
     assert!((q[0].hypot(q[1]) - 1.0).abs() < 1e-12, "{q:?}");
     // Minimum-norm projection moves q along the rod direction: same angle.
@@ -968,8 +974,14 @@ fn rheonomic_constraint_drives_the_motion_and_lambda_is_the_driving_force() {
     let mut h_max = 0.0_f64;
     // Both masses start at rest: v0 is projected onto G v + ∂g/∂t = 0, which
     // gives the driven mass its velocity A ω and leaves the free one alone.
-    let st = Park::new(ParkSettings::with_tolerances(tol, tol))
-        .run(&mut sys, 0.0, &[0.0, 0.3], &[0.0, 0.0], 2.0, |s| {
+    let st = integrate_park_steps(
+        &mut sys,
+        &ParkSettings::with_tolerances(tol, tol),
+        0.0,
+        &[0.0, 0.3],
+        &[0.0, 0.0],
+        2.0,
+        |s| {
             let t = s.t;
             h_max = h_max.max(s.h);
             worst_x = worst_x.max((s.q[0] - amp * (w * t).sin()).abs());
@@ -977,8 +989,9 @@ fn rheonomic_constraint_drives_the_motion_and_lambda_is_the_driving_force() {
             worst_force = worst_force.max((s.lambda[0] + m * amp * w * w * (w * t).sin()).abs());
             worst_free = worst_free.max((s.q[1] - 0.3).abs()).max(s.v[1].abs());
             ControlFlow::Continue(())
-        })
-        .unwrap();
+        },
+    )
+    .unwrap();
     println!(
         "driven: x {worst_x:e}, v {worst_v:e}, force {worst_force:e}, free {worst_free:e}, {st:?}"
     );
@@ -1013,20 +1026,20 @@ fn too_large_initial_step_is_recovered_by_newton_failure_or_error_test() {
     };
     let e0 = -p.g * theta0.cos();
     let mut worst_energy = 0.0_f64;
-    let st = Park::new(settings)
-        .run(
-            &mut p,
-            0.0,
-            &[theta0.sin(), -theta0.cos()],
-            &[0.0, 0.0],
-            3.0,
-            |s| {
-                let energy = 0.5 * (s.v[0] * s.v[0] + s.v[1] * s.v[1]) + 9.81 * s.q[1];
-                worst_energy = worst_energy.max((energy - e0).abs());
-                ControlFlow::Continue(())
-            },
-        )
-        .unwrap();
+    let st = integrate_park_steps(
+        &mut p,
+        &settings,
+        0.0,
+        &[theta0.sin(), -theta0.cos()],
+        &[0.0, 0.0],
+        3.0,
+        |s| {
+            let energy = 0.5 * (s.v[0] * s.v[0] + s.v[1] * s.v[1]) + 9.81 * s.q[1];
+            worst_energy = worst_energy.max((energy - e0).abs());
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
     println!("large first step: energy {worst_energy:e}, {st:?}");
     assert!(st.rejected_steps >= 1, "{st:?}");
     // Energy g l (1 − cos θ0) ≈ 4.5 J per kg conserved to 1e-4 relative.
@@ -1060,11 +1073,16 @@ fn step_loops_do_not_allocate() {
                     consistent_multipliers: true,
                     ..ParkSettings::fixed(1e-3)
                 };
-                Park::new(settings)
-                    .run(&mut p, 0.0, &[0.6, -0.8], &[0.0, 0.0], t_end, |_| {
-                        ControlFlow::Continue(())
-                    })
-                    .unwrap();
+                integrate_park_steps(
+                    &mut p,
+                    &settings,
+                    0.0,
+                    &[0.6, -0.8],
+                    &[0.0, 0.0],
+                    t_end,
+                    |_| ControlFlow::Continue(()),
+                )
+                .unwrap();
             }
             _ => {
                 let mut sys = Oscillator::new(1.0, 0.1, 100.0);
@@ -1231,4 +1249,134 @@ fn observer_can_stop_the_run() {
     assert!(st.t > 1.0 && st.t < 10.0);
     assert_eq!(calls, st.steps + 1, "initial state + one call per step");
     assert!((st.q[0] - st.t.cos()).abs() < 1e-3);
+}
+
+// ---------------------------------------------------------------------------
+// Stepping API
+// ---------------------------------------------------------------------------
+
+#[test]
+fn stepping_reaches_stop_times_exactly_and_not_beyond() {
+    // Undamped oscillator m = k = 1 from q = 1: q = cos t.
+    let mut sys = Oscillator::new(1.0, 0.0, 1.0);
+    let mut park = Park::new(
+        &mut sys,
+        ParkSettings::with_tolerances(1e-8, 1e-8),
+        0.0,
+        &[1.0],
+        &[0.0],
+    )
+    .unwrap();
+    assert_eq!(park.state().t, 0.0);
+    assert_eq!(park.state().accel, &[-1.0]);
+    let at = park.step_until(1.0).unwrap();
+    assert_eq!(at.t, 1.0);
+    assert!((at.q[0] - 1.0_f64.cos()).abs() < 1e-5, "{}", at.q[0]);
+    let steps = park.stats().steps;
+    assert!(park.step().is_err(), "no step past the stop time");
+    assert_eq!(park.stats().steps, steps);
+    // Continue to a second stop time, one step at a time (the caller's loop).
+    park.set_stop_time(2.5).unwrap();
+    while park.t() < 2.5 {
+        let s = park.step().unwrap();
+        assert!(s.t <= 2.5 && s.h > 0.0);
+    }
+    assert_eq!(park.t(), 2.5);
+    assert!((park.state().q[0] - 2.5_f64.cos()).abs() < 1e-5);
+    assert_eq!(park.stats().t, 2.5);
+    assert!(park.set_stop_time(2.0).is_err(), "a stop time in the past");
+
+    let mut rk4 = Rk4::new(&mut sys, &Rk4Settings::new(0.01), 0.0, &[1.0], &[0.0]).unwrap();
+    let at = rk4.step_until(0.995).unwrap();
+    assert_eq!(at.t, 0.995);
+    assert!((at.q[0] - 0.995_f64.cos()).abs() < 1e-8);
+    assert!(rk4.step().is_err());
+}
+
+#[test]
+fn stepping_loop_matches_the_observer_loop() {
+    let settings = ParkSettings::with_tolerances(1e-7, 1e-7);
+    let mut a = Oscillator::new(1.0, 0.3, 4.0);
+    let mut observed = Vec::new();
+    let st = integrate_park_steps(&mut a, &settings, 0.0, &[1.0], &[0.0], 3.0, |s| {
+        observed.push((s.t, s.h, s.q[0], s.v[0], s.accel[0]));
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    let mut b = Oscillator::new(1.0, 0.3, 4.0);
+    let mut park = Park::new(&mut b, settings, 0.0, &[1.0], &[0.0]).unwrap();
+    park.set_stop_time(3.0).unwrap();
+    let s = park.state();
+    let mut stepped = vec![(s.t, s.h, s.q[0], s.v[0], s.accel[0])];
+    while park.t() < 3.0 {
+        let s = park.step().unwrap();
+        stepped.push((s.t, s.h, s.q[0], s.v[0], s.accel[0]));
+    }
+    assert_eq!(observed, stepped);
+    assert_eq!(park.stats(), &st);
+}
+
+/// An oscillator whose `accept_step` fails at a given time.
+struct FailingAccept {
+    inner: Oscillator,
+    fail_after: f64,
+}
+
+impl MechanicalSystem for FailingAccept {
+    fn dof(&self) -> usize {
+        1
+    }
+
+    fn dynamics(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut DMatrix<f64>,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        self.inner.dynamics(t, q, v, mass, force)
+    }
+
+    fn accept_step(&mut self, t: f64, _q: &[f64], _v: &[f64]) -> Result<(), SimError> {
+        if t > self.fail_after {
+            return Err(SimError::Other(format!("refused the step to t = {t} s")));
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn accept_step_errors_end_the_run() {
+    let mut sys = FailingAccept {
+        inner: Oscillator::new(1.0, 0.0, 1.0),
+        fail_after: 0.5,
+    };
+    let err = integrate_park(
+        &mut sys,
+        &ParkSettings::default(),
+        0.0,
+        &[1.0],
+        &[0.0],
+        2.0,
+        |_, _, _, _| ControlFlow::Continue(()),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("refused the step"), "{err}");
+    let err = integrate_rk4(
+        &mut sys,
+        &Rk4Settings::new(0.1),
+        0.0,
+        &[1.0],
+        &[0.0],
+        2.0,
+        |_, _, _, _| ControlFlow::Continue(()),
+    )
+    .unwrap_err();
+    // The first step past 0.5 s ends at t0 + 6 h (with its rounding).
+    let t6 = 6.0 * 0.1;
+    assert_eq!(
+        err,
+        SimError::Other(format!("refused the step to t = {t6} s"))
+    );
 }

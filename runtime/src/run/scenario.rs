@@ -1,0 +1,185 @@
+//! From a scenario to a system ready to integrate: parameter values and
+//! initial state, the engine driven along the track, the restart velocities
+//! at the track's kinks, and the integrator check.
+
+use super::RunError;
+use crate::Equations;
+use crate::equations::Parts;
+use crate::forces::TrackBinding;
+use crate::inputs::{DrivenEquations, InputProvider};
+use crate::model_system::ModelSystem;
+use crate::system::SimError;
+use crate::track_inputs::{RunningSpeed, TrackInputs};
+use railmbs_models::{IntegratorSpec, Model, Scenario};
+use std::path::Path;
+
+/// Parameter values and initial state of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    /// In `Model::parameters` order.
+    pub params: Vec<f64>,
+    /// Generalized coordinates (m, rad).
+    pub q: Vec<f64>,
+    /// Generalized velocities (m/s, rad/s).
+    pub v: Vec<f64>,
+}
+
+/// The parameter values and initial state a scenario asks for (errors name the
+/// scenario file, with line and column).
+pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState, RunError> {
+    let setup = |message: String| RunError::Setup {
+        file: scenario.source.clone(),
+        message,
+    };
+    let params = scenario
+        .parameter_values(model)
+        .map_err(|e| setup(e.to_string()))?;
+    let (q, v) = scenario
+        .initial_state(model, &params)
+        .map_err(|e| setup(e.to_string()))?;
+    if let Some(i) = q.iter().chain(&v).position(|x| !x.is_finite()) {
+        return Err(setup(format!(
+            "initial state of model \"{}\" is not finite (entry {i}); check the init/vel expressions",
+            model.name
+        )));
+    }
+    Ok(InitialState { params, q, v })
+}
+
+/// An engine driven along the track: the wrapped equations, the times at
+/// which the frames pass kinks of the track, and the track for the force
+/// elements that need it.
+pub(crate) type DrivenModel = (Box<dyn Equations>, Vec<f64>, Option<TrackBinding>);
+
+/// Wraps the engine of a model with track-following frames so that the
+/// scenario's track drives them; other models pass through.
+pub(crate) fn drive_track_frames(
+    scenario: &Scenario,
+    model: &Model,
+    params: &[f64],
+    equations: Box<dyn Equations>,
+) -> Result<DrivenModel, RunError> {
+    if model.track_frames.is_empty() {
+        return Ok((equations, Vec::new(), None));
+    }
+    let setup = |message: String| RunError::Setup {
+        file: scenario.source.clone(),
+        message,
+    };
+    let Some(spec) = &scenario.track else {
+        return Err(setup(format!(
+            "model \"{}\" has {} track-following frame(s): the scenario must say which track \
+             and how fast, e.g. `track: (file: \"../tracks/tc1.ron\", start: 11.0, speed: 4.4)`",
+            model.name,
+            model.track_frames.len()
+        )));
+    };
+    let text = std::fs::read_to_string(&spec.file).map_err(|source| RunError::Io {
+        path: spec.file.clone(),
+        source,
+    })?;
+    let description: railmbs_track::TrackDescription =
+        ron::from_str(&text).map_err(|e| RunError::Setup {
+            file: spec.file.clone(),
+            message: format!("not a track description: {e}"),
+        })?;
+    let base = spec.file.parent().unwrap_or(Path::new(""));
+    let track = description.build(base).map_err(|e| RunError::Setup {
+        file: spec.file.clone(),
+        message: e.to_string(),
+    })?;
+    let speed = if spec.speed_profile.is_empty() {
+        railmbs_track::ConstantSpeed::new(spec.start, spec.speed).map(RunningSpeed::Constant)
+    } else {
+        railmbs_track::SpeedTable::new(spec.start, &spec.speed_profile).map(RunningSpeed::Profile)
+    }
+    .map_err(|e| setup(format!("track: {e}")))?;
+    let track = std::sync::Arc::new(track);
+    let inputs = TrackInputs::for_model(model, params, track.clone(), speed.clone())?;
+    let breakpoints = inputs.breakpoints(0.0, scenario.end_time);
+    // Each body's track frame: its own or its nearest ancestor's.
+    let mut body_offsets: Vec<Option<f64>> = vec![None; model.bodies.len()];
+    for (b, body) in model.bodies.iter().enumerate() {
+        body_offsets[b] = match body.parent {
+            railmbs_models::BodyRef::Body(p) => body_offsets[p],
+            railmbs_models::BodyRef::Ground => None,
+        };
+        if let Some(k) = model.track_frames.iter().position(|f| f.body == b) {
+            body_offsets[b] = Some(inputs.offsets()[k]);
+        }
+    }
+    let binding = TrackBinding {
+        track,
+        speed,
+        body_offsets,
+        tables: Default::default(),
+    };
+    Ok((
+        Box::new(DrivenEquations::new(equations, Box::new(inputs))?),
+        breakpoints,
+        Some(binding),
+    ))
+}
+
+/// One body velocity vector (v, ω) per body, stacked.
+fn body_velocities(e: &crate::equations::Evaluation) -> nalgebra::DVector<f64> {
+    nalgebra::DVector::from_iterator(
+        6 * e.bodies.len(),
+        e.bodies
+            .iter()
+            .flat_map(|b| b.velocity.iter().chain(b.angular_velocity.iter()).copied()),
+    )
+}
+
+/// Half-width (s) of the gap left around a breakpoint at `t`: segments end
+/// this much before a kink of the track and restart this much after it, so
+/// that no step ever ends exactly on the kink (where the inputs are one-sided).
+/// At 100 m/s it moves a frame by 1e-8 m per second of simulated time.
+pub(crate) fn breakpoint_gap(t: f64) -> f64 {
+    1e-10 * t.abs().max(1.0)
+}
+
+/// Velocities after a kink of the track-following frames (segment ended at
+/// `t_before`, restarts at `t_after`): the frames' rates jump there, the
+/// bodies' absolute velocities do not. Solves Γ(t⁺) q̇⁺ + γ(t⁺) = V(t⁻) for all
+/// bodies in the least-squares sense (exact for bodies with six coordinates
+/// relative to their frame), γ being the rheonomic part of the body velocities.
+pub(crate) fn continuous_velocities(
+    system: &mut ModelSystem,
+    t_before: f64,
+    t_after: f64,
+    q: &[f64],
+    v: &[f64],
+) -> Result<Vec<f64>, SimError> {
+    let t = t_before;
+    let parts = Parts {
+        jacobians: true,
+        ..Parts::KINEMATICS
+    };
+    let before = body_velocities(system.evaluate(t_before, q, v, parts)?);
+    let zero = vec![0.0; q.len()];
+    let e = system.evaluate(t_after, q, &zero, parts)?;
+    let rhs = before - body_velocities(e);
+    let solution = e
+        .jacobians
+        .clone()
+        .svd(true, true)
+        .solve(&rhs, 1e-12)
+        .map_err(|e| SimError::Other(format!("velocity re-initialization at t = {t} s: {e}")))?;
+    // Element states keep their rates (their equations hold at the next step).
+    let n = solution.len();
+    Ok(solution.iter().chain(&v[n..]).copied().collect())
+}
+
+/// Refuses an explicit integrator for a system with first-order element
+/// states (their rows of the mass matrix are zero).
+pub(crate) fn check_integrator(system: &ModelSystem, spec: &IntegratorSpec) -> Result<(), String> {
+    if matches!(spec, IntegratorSpec::Rk4 { .. }) && system.state_count() > 0 {
+        return Err(format!(
+            "the model has first-order element states ({}) which the explicit RK4 integrator \
+             cannot solve; use `integrator: Park(..)`",
+            system.state_names().join(", ")
+        ));
+    }
+    Ok(())
+}
