@@ -97,6 +97,21 @@ pub struct ScenarioTrack {
     pub track: Arc<Track>,
 }
 
+impl ScenarioTrack {
+    /// Puts the scenario on the track of `file` instead (read, parsed and built
+    /// as when the scenario loads; `file` replaces [`ScenarioTrack::file`]).
+    pub fn load_file(&mut self, file: &Path) -> Result<(), ModelErrors> {
+        *self = PendingTrack {
+            file: file.to_path_buf(),
+            start: self.start,
+            speed: self.speed,
+            speed_profile: self.speed_profile.clone(),
+        }
+        .load()?;
+        Ok(())
+    }
+}
+
 /// A scenario's track settings, validated, before the track file is read.
 struct PendingTrack {
     file: PathBuf,

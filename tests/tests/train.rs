@@ -439,7 +439,7 @@ fn symbolic_and_numeric_engines_agree_on_a_train() {
     )
     .unwrap();
     let mut train = train3(1.0);
-    train.track.file = track;
+    train.track.load_file(&track).unwrap();
     let (a, _) = run(&train, numeric, &dir.path().join("numeric.csv"));
     let (b, summary) = run(
         &train,

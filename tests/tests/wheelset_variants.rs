@@ -313,7 +313,7 @@ fn independently_rotating_wheels_roll_at_the_speed_of_their_own_path_in_a_curve(
     .unwrap();
     let t = run_edited("scenarios/wheelset_irw_off_centre.ron", |s| {
         let tr = s.track.as_mut().unwrap();
-        tr.file = track.clone();
+        tr.load_file(&track).unwrap();
         tr.start = 0.0;
         tr.speed = 10.0;
         // Manchester Vehicle 1's primary suspension (wheelset_on_springs.ron).

@@ -213,7 +213,7 @@ fn vehicle1_on_perfect_straight_track_stays_centred() {
     let mut scenario =
         railmbs_models::load_scenario(&model_path("scenarios/vehicle1_tc1.ron")).unwrap();
     let track = scenario.track.as_mut().unwrap();
-    track.file = model_path("tracks/straight.ron");
+    track.load_file(&model_path("tracks/straight.ron")).unwrap();
     track.speed = 30.0;
     scenario.parameters = vec![("v0".into(), "30.0".into())];
     scenario.end_time = 3.0;
@@ -449,7 +449,7 @@ fn energy_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64,
 /// c_traction = 0`) at 30 m/s on perfect straight track, written every 2 ms.
 fn coasting_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64, f64) {
     let track = scenario.track.as_mut().unwrap();
-    track.file = model_path("tracks/straight.ron");
+    track.load_file(&model_path("tracks/straight.ron")).unwrap();
     track.speed_profile.clear();
     track.speed = 30.0;
     for (name, value) in [("v0", "30"), ("k_traction", "0"), ("c_traction", "0")] {

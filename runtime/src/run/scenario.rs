@@ -11,7 +11,6 @@ use crate::model_system::ModelSystem;
 use crate::system::SimError;
 use crate::track_inputs::{RunningSpeed, TrackInputs};
 use railmbs_models::{IntegratorSpec, Model, Scenario};
-use std::path::Path;
 
 /// Parameter values and initial state of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,27 +73,14 @@ pub(crate) fn drive_track_frames(
             model.track_frames.len()
         )));
     };
-    let text = std::fs::read_to_string(&spec.file).map_err(|source| RunError::Io {
-        path: spec.file.clone(),
-        source,
-    })?;
-    let description: railmbs_track::TrackDescription =
-        ron::from_str(&text).map_err(|e| RunError::Setup {
-            file: spec.file.clone(),
-            message: format!("not a track description: {e}"),
-        })?;
-    let base = spec.file.parent().unwrap_or(Path::new(""));
-    let track = description.build(base).map_err(|e| RunError::Setup {
-        file: spec.file.clone(),
-        message: e.to_string(),
-    })?;
     let speed = if spec.speed_profile.is_empty() {
         railmbs_track::ConstantSpeed::new(spec.start, spec.speed).map(RunningSpeed::Constant)
     } else {
         railmbs_track::SpeedTable::new(spec.start, &spec.speed_profile).map(RunningSpeed::Profile)
     }
     .map_err(|e| setup(format!("track: {e}")))?;
-    let track = std::sync::Arc::new(track);
+    // The track was read and built when the scenario was loaded.
+    let track = spec.track.clone();
     let inputs = TrackInputs::for_model(model, params, track.clone(), speed.clone())?;
     let breakpoints = inputs.breakpoints(0.0, scenario.end_time);
     // Each body's track frame: its own or its nearest ancestor's.
