@@ -324,6 +324,7 @@
 
 mod error;
 pub mod expr;
+pub mod forces;
 mod load;
 mod locate;
 mod methods;

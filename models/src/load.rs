@@ -2,6 +2,7 @@
 
 use crate::error::{ModelError, ModelErrors};
 use crate::expr::{Expr, VAR_NAMES};
+use crate::forces::{Checks, ForceSpec};
 use crate::locate::{Locator, Span};
 use crate::model::*;
 use crate::parser::{ParseErrorKind, is_identifier, is_reserved_name, parse_expr, parse_expr_vars};
@@ -10,7 +11,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 mod include;
-use include::{Connection, Includes, Loaded, Node, Sub, close_matches, force_value_problems};
+use include::{Connection, Includes, Loaded, Node, Sub, close_matches};
 
 /// Reads and resolves a model file, flattening its subsystems (recursively).
 /// All problems found are returned together.
@@ -78,23 +79,13 @@ pub(crate) fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError)
 const BODY: &[&str] = &["Body"];
 const SUBSYSTEM: &[&str] = &["Subsystem"];
 const CUT: &[&str] = &["CutJoint"];
-const FORCE: &[&str] = &[
-    "Spring",
-    "Linear6",
-    "Applied",
-    "PointPlane",
-    "Coulomb",
-    "LoadFriction",
-    "Tabulated",
-    "WheelRail",
-];
+const FORCE: &[&str] = crate::forces::CONSTRUCTORS;
 
 fn kind_of(ctor: &str) -> &'static str {
     match ctor {
         "Body" => "body",
         "CutJoint" => "cut joint",
-        "Spring" | "Linear6" | "Applied" | "PointPlane" | "Coulomb" | "LoadFriction"
-        | "Tabulated" | "WheelRail" => "force",
+        c if FORCE.contains(&c) => "force",
         "Subsystem" => "subsystem",
         "Scenario" => "scenario",
         "Model" => "model",
@@ -104,7 +95,7 @@ fn kind_of(ctor: &str) -> &'static str {
 
 /// Where an error is: used to name the element and to find its position.
 #[derive(Debug, Clone)]
-enum Where {
+pub(crate) enum Where {
     Top,
     /// Constructors, name, occurrence (0 = first element with that name).
     Elem(&'static [&'static str], String, usize),
@@ -130,8 +121,8 @@ impl Where {
     }
 }
 
-struct Cx<'a> {
-    file: &'a Path,
+pub(crate) struct Cx<'a> {
+    pub(crate) file: &'a Path,
     loc: Locator<'a>,
     errors: Vec<ModelError>,
     /// Errors of included files, complete with their inclusion note.
@@ -142,7 +133,7 @@ struct Cx<'a> {
     /// Parameter names, index = `Expr::Param` index.
     names: Vec<String>,
     /// Default parameter values, when they could all be evaluated.
-    defaults: Option<Vec<f64>>,
+    pub(crate) defaults: Option<Vec<f64>>,
     /// Track-frame offsets by body name (bodies whose joint starts with a
     /// track-following frame).
     track_offsets: HashMap<String, Expr>,
@@ -199,7 +190,13 @@ impl Cx<'_> {
     }
 
     /// Records an error at the string literal `literal` or the key `key` inside the element.
-    fn err(&mut self, w: &Where, key: Option<&str>, literal: Option<&str>, message: String) {
+    pub(crate) fn err(
+        &mut self,
+        w: &Where,
+        key: Option<&str>,
+        literal: Option<&str>,
+        message: String,
+    ) {
         let position = self.span_of(w).map(|span| {
             let tok = literal
                 .and_then(|l| self.loc.string_in(span, l))
@@ -219,7 +216,7 @@ impl Cx<'_> {
     /// The height z = f(x, y) of a point–Z-surface contact: an expression in
     /// the local variables x, y and the parameters, finite with the default
     /// parameters at x = y = 0.
-    fn surface_expr(&mut self, w: &Where, v: &Value) -> Expr {
+    pub(crate) fn surface_expr(&mut self, w: &Where, v: &Value) -> Expr {
         let s = match v {
             Value::Num(x) => return self.expr(w, "surface", "surface", &Value::Num(*x), false),
             Value::Text(s) => s,
@@ -259,7 +256,14 @@ impl Cx<'_> {
         }
     }
 
-    fn expr(&mut self, w: &Where, label: &str, key: &str, v: &Value, allow_time: bool) -> Expr {
+    pub(crate) fn expr(
+        &mut self,
+        w: &Where,
+        label: &str,
+        key: &str,
+        v: &Value,
+        allow_time: bool,
+    ) -> Expr {
         match v {
             Value::Num(x) => {
                 if !x.is_finite() {
@@ -307,7 +311,7 @@ impl Cx<'_> {
         }
     }
 
-    fn vec3(&mut self, w: &Where, label: &str, v: &Vec3, allow_time: bool) -> [Expr; 3] {
+    pub(crate) fn vec3(&mut self, w: &Where, label: &str, v: &Vec3, allow_time: bool) -> [Expr; 3] {
         let comps = [&v.0, &v.1, &v.2];
         std::array::from_fn(|i| {
             let l = format!("{label}.{}", ["x", "y", "z"][i]);
@@ -315,7 +319,7 @@ impl Cx<'_> {
         })
     }
 
-    fn vec6(&mut self, w: &Where, label: &str, v: &Vec6) -> [Expr; 6] {
+    pub(crate) fn vec6(&mut self, w: &Where, label: &str, v: &Vec6) -> [Expr; 6] {
         let comps = [&v.0, &v.1, &v.2, &v.3, &v.4, &v.5];
         std::array::from_fn(|i| self.expr(w, &format!("{label}[{i}]"), label, comps[i], false))
     }
@@ -422,7 +426,9 @@ impl Cx<'_> {
             if let Some(x) = found {
                 problems.push((format!("force \"{}\"", f.name), f.name.clone(), x));
             }
-            for message in force_value_problems(&f.kind, &d) {
+            let mut checks = Checks::new(&d);
+            f.kind.check(&mut checks);
+            for (_, message) in checks.problems {
                 ranges.push((f.name.clone(), message));
             }
         }
@@ -1359,7 +1365,7 @@ struct JointBuilder<'a> {
 
 /// What a name in a force element or cut joint refers to.
 #[derive(Debug, Clone)]
-enum Target {
+pub(crate) enum Target {
     Body(BodyRef),
     /// A connection point: a point (in the body frame) of a body.
     Conn(BodyRef, [Expr; 3]),
@@ -1368,12 +1374,12 @@ enum Target {
 }
 
 /// Bodies and connection points by (long) name.
-struct Lookup {
-    names: HashMap<String, Target>,
+pub(crate) struct Lookup {
+    pub(crate) names: HashMap<String, Target>,
 }
 
 /// `a + b` componentwise, folding literal zeros and numbers.
-fn add3(a: &[Expr; 3], b: [Expr; 3]) -> [Expr; 3] {
+pub(crate) fn add3(a: &[Expr; 3], b: [Expr; 3]) -> [Expr; 3] {
     let mut b = b.into_iter();
     std::array::from_fn(|k| {
         let y = b.next().unwrap_or(Expr::Num(0.0));
@@ -1389,7 +1395,7 @@ fn add3(a: &[Expr; 3], b: [Expr; 3]) -> [Expr; 3] {
 impl Cx<'_> {
     /// The body (or connection point) `name` written at `key`: the body and
     /// the connection's point, if it is one.
-    fn target(
+    pub(crate) fn target(
         &mut self,
         w: &Where,
         key: &str,
@@ -1421,7 +1427,13 @@ impl Cx<'_> {
     }
 
     /// A body; a connection point is an error here.
-    fn body_ref(&mut self, w: &Where, key: &str, name: &str, lookup: &Lookup) -> BodyRef {
+    pub(crate) fn body_ref(
+        &mut self,
+        w: &Where,
+        key: &str,
+        name: &str,
+        lookup: &Lookup,
+    ) -> BodyRef {
         let (b, conn) = self.target(w, key, name, lookup);
         if conn.is_some() {
             self.err(
@@ -1436,7 +1448,7 @@ impl Cx<'_> {
 
     /// A body or connection point and a point: `point` is in the body frame,
     /// relative to the connection point if `name` is one.
-    fn attach(
+    pub(crate) fn attach(
         &mut self,
         w: &Where,
         (key, name): (&str, &str),
@@ -1452,7 +1464,7 @@ impl Cx<'_> {
     }
 
     /// The two ends of a two-point element (see [`Cx::attach`]).
-    fn two_points(
+    pub(crate) fn two_points(
         &mut self,
         w: &Where,
         (body1, point1): (&str, &Vec3),
@@ -1466,7 +1478,7 @@ impl Cx<'_> {
 
     /// A frame on a body or connection point (see [`Cx::attach`]).
     #[allow(clippy::too_many_arguments)]
-    fn attach_frame(
+    pub(crate) fn attach_frame(
         &mut self,
         w: &Where,
         body: (&str, &str),
@@ -1580,122 +1592,16 @@ impl Cx<'_> {
         out
     }
 
-    fn matrix6(&mut self, w: &Where, key: &str, m: &RawMatrix6) -> Box<[Expr; 36]> {
-        let mut out: Box<[Expr; 36]> = Box::new(std::array::from_fn(|_| Expr::Num(0.0)));
-        match m {
-            RawMatrix6::Diag(d) => {
-                let d = self.vec6(w, key, d);
-                for (k, e) in d.into_iter().enumerate() {
-                    out[7 * k] = e;
-                }
-            }
-            RawMatrix6::VerticalSpring {
-                vertical,
-                shear,
-                bending,
-                torsion,
-                height,
-            } => {
-                // Energy ½ c_s |s|² + ½ c_b (θx² + θy²) + ½ c_z u_z² + ½ c_t θz²,
-                // the shear s = (u_x + θy H/2, u_y − θx H/2) being the offset of
-                // the upper plate's material point at mid-height (frames at the
-                // lower plate; u, θ the upper body's displacement and rotation
-                // there). Its Hessian couples shear and tilt by ±c_s H/2.
-                let e = |this: &mut Self, name: &str, v: &Value| {
-                    this.expr(w, &format!("{key}.{name}"), key, v, false)
-                };
-                let cz = e(self, "vertical", vertical);
-                let cs = e(self, "shear", shear);
-                let cb = e(self, "bending", bending);
-                let ct = e(self, "torsion", torsion);
-                let h = e(self, "height", height);
-                let half = Expr::Div(Box::new(h), Box::new(Expr::Num(2.0)));
-                let cs_half = Expr::Mul(Box::new(cs.clone()), Box::new(half.clone()));
-                let tilt = Expr::Add(
-                    Box::new(cb),
-                    Box::new(Expr::Mul(Box::new(cs_half.clone()), Box::new(half))),
-                );
-                out[0] = cs.clone();
-                out[7] = cs;
-                out[14] = cz;
-                out[21] = tilt.clone();
-                out[28] = tilt;
-                out[35] = ct;
-                out[4] = cs_half.clone(); // (u_x, θy)
-                out[24] = cs_half.clone();
-                out[9] = Expr::Neg(Box::new(cs_half.clone())); // (u_y, θx)
-                out[19] = Expr::Neg(Box::new(cs_half));
-            }
-            RawMatrix6::Full(v) => {
-                if v.len() != 36 {
-                    self.err(
-                        w,
-                        Some(key),
-                        None,
-                        format!(
-                            "{key} must have 36 values (6×6, row-major), got {}",
-                            v.len()
-                        ),
-                    );
-                }
-                for (k, x) in v.iter().take(36).enumerate() {
-                    out[k] = self.expr(w, &format!("{key}[{}][{}]", k / 6, k % 6), key, x, false);
-                }
-            }
-        }
-        out
-    }
-
-    /// With default parameters: `e` > 0 (a stiffness).
-    fn check_positive(&mut self, w: &Where, key: &str, e: &Expr) {
-        if let Some(d) = &self.defaults {
-            let x = e.eval(d, 0.0);
-            if x.is_finite() && x <= 0.0 {
-                self.err(
-                    w,
-                    Some(key),
-                    None,
-                    format!("{key} must be positive, got {x}"),
-                );
-            }
-        }
-    }
-
-    /// With default parameters: `e` ≥ 0 (a damping).
-    fn check_non_negative(&mut self, w: &Where, key: &str, e: &Expr) {
-        if let Some(d) = &self.defaults {
-            let x = e.eval(d, 0.0);
-            if x.is_finite() && x < 0.0 {
-                self.err(
-                    w,
-                    Some(key),
-                    None,
-                    format!("{key} must not be negative, got {x}"),
-                );
-            }
-        }
-    }
-
-    /// With default parameters: 0 ≤ sliding ≤ static (friction coefficients
-    /// or forces).
-    fn check_friction(&mut self, w: &Where, key: &str, sliding: &Expr, key0: &str, stat: &Expr) {
-        if let Some(d) = &self.defaults {
-            let (s, s0) = (sliding.eval(d, 0.0), stat.eval(d, 0.0));
-            if s.is_finite() && s < 0.0 {
-                self.err(
-                    w,
-                    Some(key),
-                    None,
-                    format!("{key} must not be negative, got {s}"),
-                );
-            } else if s.is_finite() && s0.is_finite() && s > s0 {
-                self.err(
-                    w,
-                    Some(key),
-                    None,
-                    format!("{key} = {s} must not exceed {key0} = {s0}"),
-                );
-            }
+    /// Runs a force element's range checks ([`ForceSpec::check`]) with the
+    /// default parameters and reports each problem at its field.
+    pub(crate) fn check(&mut self, w: &Where, spec: &impl ForceSpec) {
+        let Some(d) = self.defaults.clone() else {
+            return;
+        };
+        let mut checks = Checks::new(&d);
+        spec.check(&mut checks);
+        for (key, message) in checks.problems {
+            self.err(w, Some(key), None, message);
         }
     }
 
@@ -1717,424 +1623,8 @@ impl Cx<'_> {
                     "a force needs a non-empty name".into(),
                 );
             }
-            let kind = match f {
-                RawForce::Spring {
-                    body1,
-                    point1,
-                    body2,
-                    point2,
-                    c,
-                    d,
-                    f0,
-                    x0,
-                    ..
-                } => {
-                    let (body1, point1, body2, point2) =
-                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
-                    ForceKind::Bipolar {
-                        body1,
-                        point1,
-                        body2,
-                        point2,
-                        stiffness: self.expr(&w, "c", "c", c, false),
-                        damping: self.expr(&w, "d", "d", d, false),
-                        preload: self.expr(&w, "f0", "f0", f0, false),
-                        free_length: self.expr(&w, "x0", "x0", x0, false),
-                    }
-                }
-                RawForce::SeriesSpring {
-                    body1,
-                    point1,
-                    body2,
-                    point2,
-                    c,
-                    d,
-                    f0,
-                    ..
-                } => {
-                    let stiffness = self.expr(&w, "c", "c", c, false);
-                    let damping = self.expr(&w, "d", "d", d, false);
-                    self.check_positive(&w, "c", &stiffness);
-                    self.check_positive(&w, "d", &damping);
-                    let (body1, point1, body2, point2) =
-                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
-                    ForceKind::SeriesSpringDamper {
-                        body1,
-                        point1,
-                        body2,
-                        point2,
-                        stiffness,
-                        damping,
-                        preload: self.expr(&w, "f0", "f0", f0, false),
-                    }
-                }
-                RawForce::Linear6 {
-                    body1,
-                    point1,
-                    rotation1,
-                    body2,
-                    point2,
-                    rotation2,
-                    stiffness,
-                    damping,
-                    preload,
-                    ..
-                } => {
-                    let (body1, frame1) = self.attach_frame(
-                        &w,
-                        ("body1", body1),
-                        ("point1", point1),
-                        "rotation1",
-                        rotation1,
-                        lookup,
-                    );
-                    let (body2, frame2) = self.attach_frame(
-                        &w,
-                        ("body2", body2),
-                        ("point2", point2),
-                        "rotation2",
-                        rotation2,
-                        lookup,
-                    );
-                    let stiffness = self.matrix6(&w, "stiffness", stiffness);
-                    let damping = self.matrix6(&w, "damping", damping);
-                    let preload = self.vec6(&w, "preload", preload);
-                    ForceKind::Linear6 {
-                        body1,
-                        frame1,
-                        body2,
-                        frame2,
-                        stiffness,
-                        damping,
-                        preload,
-                    }
-                }
-                RawForce::PointPlane {
-                    body,
-                    points,
-                    plane_body,
-                    origin,
-                    normal,
-                    surface,
-                    c,
-                    d,
-                    ct,
-                    dt,
-                    mu0,
-                    mu,
-                    ..
-                } => {
-                    let (body_ref, body_conn) = self.target(&w, "body", body, lookup);
-                    let (plane_ref, plane_conn) = self.target(&w, "plane_body", plane_body, lookup);
-                    if body_ref == plane_ref && body == plane_body {
-                        self.err(
-                            &w,
-                            Some("plane_body"),
-                            None,
-                            "the plane must belong to another body than the points".into(),
-                        );
-                    }
-                    if points.is_empty() {
-                        self.err(&w, Some("points"), None, "needs at least one point".into());
-                    }
-                    let points: Vec<[Expr; 3]> = points
-                        .iter()
-                        .enumerate()
-                        .map(|(k, p)| {
-                            let p = self.vec3(&w, &format!("points[{k}]"), p, false);
-                            match &body_conn {
-                                Some(c) => add3(c, p),
-                                None => p,
-                            }
-                        })
-                        .collect();
-                    let normal_e = self.vec3(&w, "normal", normal, false);
-                    let surface = surface.as_ref().map(|v| self.surface_expr(&w, v));
-                    if surface.is_some() && *normal != crate::raw::unit_z() {
-                        self.err(
-                            &w,
-                            Some("normal"),
-                            None,
-                            "a Z-surface's normal follows from its slope: leave `normal` out"
-                                .into(),
-                        );
-                    }
-                    if let Some(defs) = &self.defaults {
-                        let len2: f64 = normal_e.iter().map(|e| e.eval(defs, 0.0).powi(2)).sum();
-                        if len2.is_finite() && len2 == 0.0 {
-                            self.err(&w, Some("normal"), None, "normal must not be zero".into());
-                        }
-                    }
-                    let stiffness = self.expr(&w, "c", "c", c, false);
-                    let damping = self.expr(&w, "d", "d", d, false);
-                    let tangential_stiffness = match ct {
-                        Some(v) => self.expr(&w, "ct", "ct", v, false),
-                        None => stiffness.clone(),
-                    };
-                    let tangential_damping = match dt {
-                        Some(v) => self.expr(&w, "dt", "dt", v, false),
-                        None => damping.clone(),
-                    };
-                    let mu = self.expr(&w, "mu", "mu", mu, false);
-                    let mu_static = match mu0 {
-                        Some(v) => self.expr(&w, "mu0", "mu0", v, false),
-                        None => mu.clone(),
-                    };
-                    self.check_positive(&w, "c", &stiffness);
-                    self.check_positive(&w, "ct", &tangential_stiffness);
-                    self.check_non_negative(&w, "d", &damping);
-                    self.check_non_negative(&w, "dt", &tangential_damping);
-                    self.check_friction(&w, "mu", &mu, "mu0", &mu_static);
-                    ForceKind::PointPlane {
-                        body: body_ref,
-                        points,
-                        plane_body: plane_ref,
-                        origin: {
-                            let o = self.vec3(&w, "origin", origin, false);
-                            match &plane_conn {
-                                Some(c) => add3(c, o),
-                                None => o,
-                            }
-                        },
-                        normal: normal_e,
-                        surface,
-                        stiffness,
-                        damping,
-                        tangential_stiffness,
-                        tangential_damping,
-                        mu_static,
-                        mu,
-                    }
-                }
-                RawForce::Coulomb {
-                    body1,
-                    point1,
-                    body2,
-                    point2,
-                    c,
-                    d,
-                    limit,
-                    sliding,
-                    ..
-                } => {
-                    let stiffness = self.expr(&w, "c", "c", c, false);
-                    let damping = self.expr(&w, "d", "d", d, false);
-                    let static_limit = self.expr(&w, "limit", "limit", limit, false);
-                    let sliding_force = match sliding {
-                        Some(v) => self.expr(&w, "sliding", "sliding", v, false),
-                        None => static_limit.clone(),
-                    };
-                    self.check_positive(&w, "c", &stiffness);
-                    self.check_non_negative(&w, "d", &damping);
-                    self.check_friction(&w, "sliding", &sliding_force, "limit", &static_limit);
-                    let (body1, point1, body2, point2) =
-                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
-                    ForceKind::Coulomb {
-                        body1,
-                        point1,
-                        body2,
-                        point2,
-                        stiffness,
-                        damping,
-                        static_limit,
-                        sliding_force,
-                    }
-                }
-                RawForce::LoadFriction {
-                    body1,
-                    point1,
-                    body2,
-                    point2,
-                    c1,
-                    c2,
-                    mu0,
-                    mu,
-                    x0,
-                    ..
-                } => {
-                    let c1 = self.expr(&w, "c1", "c1", c1, false);
-                    let c2 = self.expr(&w, "c2", "c2", c2, false);
-                    let mu = self.expr(&w, "mu", "mu", mu, false);
-                    let mu_static = match mu0 {
-                        Some(v) => self.expr(&w, "mu0", "mu0", v, false),
-                        None => mu.clone(),
-                    };
-                    self.check_positive(&w, "c1", &c1);
-                    self.check_positive(&w, "c2", &c2);
-                    self.check_friction(&w, "mu", &mu, "mu0", &mu_static);
-                    if let Some(defs) = &self.defaults {
-                        let m0 = mu_static.eval(defs, 0.0);
-                        if m0.is_finite() && m0 >= 1.0 {
-                            self.err(
-                                &w,
-                                Some("mu0"),
-                                None,
-                                format!("mu0 must be below 1 (the unloading branch would lock), got {m0}"),
-                            );
-                        }
-                    }
-                    let (body1, point1, body2, point2) =
-                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
-                    ForceKind::LoadFriction {
-                        body1,
-                        point1,
-                        body2,
-                        point2,
-                        c1,
-                        c2,
-                        mu_static,
-                        mu,
-                        free_length: self.expr(&w, "x0", "x0", x0, false),
-                    }
-                }
-                RawForce::Tabulated {
-                    body1,
-                    point1,
-                    body2,
-                    point2,
-                    table,
-                    interpolation,
-                    d,
-                    x0,
-                    ..
-                } => {
-                    if table.len() < 2 {
-                        self.err(
-                            &w,
-                            Some("table"),
-                            None,
-                            format!("table needs at least 2 rows, got {}", table.len()),
-                        );
-                    }
-                    let rows: Vec<(Expr, Expr)> = table
-                        .iter()
-                        .enumerate()
-                        .map(|(k, (x, f))| {
-                            (
-                                self.expr(&w, &format!("table[{k}].deflection"), "table", x, false),
-                                self.expr(&w, &format!("table[{k}].force"), "table", f, false),
-                            )
-                        })
-                        .collect();
-                    if let Some(defs) = self.defaults.clone() {
-                        let xs: Vec<f64> = rows.iter().map(|(x, _)| x.eval(&defs, 0.0)).collect();
-                        if let Some(k) = (1..xs.len()).find(|&k| {
-                            xs[k].partial_cmp(&xs[k - 1]) != Some(std::cmp::Ordering::Greater)
-                        }) {
-                            self.err(
-                                &w,
-                                Some("table"),
-                                None,
-                                format!(
-                                    "table deflections must increase: row {k} has {} after {}",
-                                    xs[k],
-                                    xs[k - 1]
-                                ),
-                            );
-                        }
-                    }
-                    let damping = self.expr(&w, "d", "d", d, false);
-                    self.check_non_negative(&w, "d", &damping);
-                    let (body1, point1, body2, point2) =
-                        self.two_points(&w, (body1, point1), (body2, point2), lookup);
-                    ForceKind::Tabulated {
-                        body1,
-                        point1,
-                        body2,
-                        point2,
-                        table: rows,
-                        interpolation: *interpolation,
-                        damping,
-                        free_length: self.expr(&w, "x0", "x0", x0, false),
-                    }
-                }
-                RawForce::WheelRail {
-                    wheelset,
-                    wheel_profile,
-                    wheel_profile_right,
-                    rail_profile,
-                    rail_profile_right,
-                    rail_profile_inclined,
-                    radius,
-                    flange_back_distance,
-                    taping_offset,
-                    mu,
-                    young,
-                    poisson,
-                    normal_damping,
-                    creep,
-                    rail,
-                    table,
-                    wheels,
-                    ..
-                } => self.wheel_rail(
-                    &w,
-                    lookup,
-                    WheelRailRaw {
-                        wheelset,
-                        profiles: [
-                            ("wheel_profile", Some(wheel_profile)),
-                            ("wheel_profile_right", wheel_profile_right.as_ref()),
-                            ("rail_profile", Some(rail_profile)),
-                            ("rail_profile_right", rail_profile_right.as_ref()),
-                        ],
-                        values: [
-                            ("radius", radius),
-                            ("flange_back_distance", flange_back_distance),
-                            ("taping_offset", taping_offset),
-                            ("mu", mu),
-                            ("young", young),
-                            ("poisson", poisson),
-                            ("normal_damping", normal_damping),
-                        ],
-                        rail_profile_inclined: *rail_profile_inclined,
-                        creep,
-                        rail,
-                        table,
-                        wheels: wheels.as_ref(),
-                    },
-                ),
-                RawForce::Applied {
-                    body,
-                    point,
-                    force,
-                    torque,
-                    frame,
-                    ..
-                } => {
-                    let (body_ref, point) =
-                        self.attach(&w, ("body", body), ("point", point), lookup);
-                    let body = match body_ref {
-                        BodyRef::Body(k) => k,
-                        BodyRef::Ground => {
-                            let on_ground = body == "ground"
-                                || matches!(
-                                    lookup.names.get(body.as_str()),
-                                    Some(Target::Conn(..))
-                                );
-                            if on_ground {
-                                self.err(
-                                    &w,
-                                    Some("body"),
-                                    None,
-                                    "an applied force acts on a body, not on ground".into(),
-                                );
-                            }
-                            0
-                        }
-                    };
-                    ForceKind::Applied {
-                        body,
-                        point,
-                        force: self.vec3(&w, "force", force, true),
-                        torque: self.vec3(&w, "torque", torque, true),
-                        frame: match frame {
-                            RawFrame::Body => VectorFrame::Body,
-                            RawFrame::Global => VectorFrame::Global,
-                        },
-                    }
-                }
-            };
+            let kind = f.resolve(self, &w, lookup);
+            self.check(&w, &kind);
             out.push(ForceElement {
                 name: name.to_string(),
                 kind,
@@ -2236,255 +1726,6 @@ impl Cx<'_> {
             });
         }
         out
-    }
-}
-
-/// The fields of a raw `WheelRail` element, borrowed for resolution.
-struct WheelRailRaw<'r> {
-    wheelset: &'r str,
-    /// (key, path text): wheel left/right, rail left/right.
-    profiles: [(&'static str, Option<&'r String>); 4],
-    /// (key, value): radius, flange_back_distance, taping_offset, mu, young,
-    /// poisson, normal_damping.
-    values: [(&'static str, &'r Value); 7],
-    rail_profile_inclined: bool,
-    creep: &'r RawCreepLaw,
-    rail: &'r RawRail,
-    table: &'r RawTable,
-    /// Independently rotating wheels' bodies (left, right), if any.
-    wheels: Option<&'r (String, String)>,
-}
-
-impl Cx<'_> {
-    /// Resolves a wheel–rail element: the wheelset body, profile files (paths
-    /// relative to the model file, which must exist; stored canonical), material and friction
-    /// values (checked with the defaults), the creep law, rails and table grid.
-    fn wheel_rail(&mut self, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> ForceKind {
-        let wheelset = match self.body_ref(w, "wheelset", raw.wheelset, lookup) {
-            BodyRef::Body(k) => k,
-            BodyRef::Ground => {
-                if raw.wheelset == "ground" {
-                    self.err(
-                        w,
-                        Some("wheelset"),
-                        None,
-                        "the wheelset must be a body, not ground".into(),
-                    );
-                }
-                0
-            }
-        };
-        let base = self.file.parent().unwrap_or(Path::new("."));
-        let mut paths: Vec<PathBuf> = Vec::with_capacity(4);
-        for (k, (key, text)) in raw.profiles.iter().enumerate() {
-            // A missing right-hand profile is the left one (mirrored when placed).
-            let Some(text) = text.or(raw.profiles[k - k % 2].1) else {
-                paths.push(PathBuf::new());
-                continue;
-            };
-            let path = base.join(text);
-            if text.is_empty() || !path.is_file() {
-                self.err(
-                    w,
-                    Some(key),
-                    Some(text),
-                    format!("profile file not found: {}", path.display()),
-                );
-            }
-            // Absolute, so that the resolved model does not depend on the
-            // working directory (nor on which file included this one).
-            paths.push(std::fs::canonicalize(&path).unwrap_or(path));
-        }
-        let e: Vec<Expr> = raw
-            .values
-            .iter()
-            .map(|(key, v)| self.expr(w, key, key, v, false))
-            .collect();
-        for (k, key) in ["radius", "flange_back_distance", "young"]
-            .iter()
-            .enumerate()
-        {
-            let idx = [0, 1, 4][k];
-            self.check_positive(w, key, &e[idx]);
-        }
-        for (idx, key) in [(2, "taping_offset"), (3, "mu"), (6, "normal_damping")] {
-            self.check_non_negative(w, key, &e[idx]);
-        }
-        if let Some(d) = &self.defaults {
-            let nu = e[5].eval(d, 0.0);
-            if nu.is_finite() && !(0.0..=0.5).contains(&nu) {
-                self.err(
-                    w,
-                    Some("poisson"),
-                    None,
-                    format!("poisson must be in [0, 0.5], got {nu}"),
-                );
-            }
-        }
-        let creep = match raw.creep {
-            RawCreepLaw::Kalker => CreepLawKind::Kalker,
-            RawCreepLaw::Mueller { exponent } => {
-                let exponent = self.expr(w, "creep.exponent", "exponent", exponent, false);
-                self.check_positive(w, "exponent", &exponent);
-                CreepLawKind::Mueller { exponent }
-            }
-            RawCreepLaw::Fastsim { nx, ny } => {
-                if *nx == 0 || *ny == 0 {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!("FASTSIM needs at least one element each way, got {nx} × {ny}"),
-                    );
-                }
-                CreepLawKind::Fastsim { nx: *nx, ny: *ny }
-            }
-            RawCreepLaw::FastsimA { strips, sliding } => {
-                if *strips == 0 {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        "FastSim_A needs at least one strip".into(),
-                    );
-                }
-                if let SlidingZoneKind::Integrated { nodes } | SlidingZoneKind::Picard { nodes } =
-                    sliding
-                    && !(1..=32).contains(nodes)
-                {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!("FastSim_A sliding-zone nodes must be in 1..=32, got {nodes}"),
-                    );
-                }
-                CreepLawKind::FastsimA {
-                    strips: *strips,
-                    sliding: *sliding,
-                }
-            }
-            RawCreepLaw::Polach {
-                ka,
-                ks,
-                friction_decrease,
-            } => {
-                for (key, v) in [("ka", ka), ("ks", ks)] {
-                    if !(*v > 0.0 && *v <= 1.0) {
-                        self.err(
-                            w,
-                            Some("creep"),
-                            None,
-                            format!("Polach {key} must be in (0, 1], got {v}"),
-                        );
-                    }
-                }
-                if let Some((a, b)) = friction_decrease
-                    && !(*a >= 0.0 && a.is_finite() && *b >= 0.0 && b.is_finite())
-                {
-                    self.err(
-                        w,
-                        Some("creep"),
-                        None,
-                        format!(
-                            "Polach friction_decrease (A, B) needs A ≥ 0 and B ≥ 0 s/m, got ({a}, {b})"
-                        ),
-                    );
-                }
-                CreepLawKind::Polach {
-                    ka: *ka,
-                    ks: *ks,
-                    friction_decrease: *friction_decrease,
-                }
-            }
-        };
-        let rail = match raw.rail {
-            RawRail::Rigid => RailKind::Rigid,
-            RawRail::Elastic { ky, cy, kz, cz } => {
-                let ky = self.expr(w, "rail.ky", "ky", ky, false);
-                let cy = self.expr(w, "rail.cy", "cy", cy, false);
-                let kz = self.expr(w, "rail.kz", "kz", kz, false);
-                let cz = self.expr(w, "rail.cz", "cz", cz, false);
-                self.check_positive(w, "ky", &ky);
-                self.check_positive(w, "kz", &kz);
-                self.check_non_negative(w, "cy", &cy);
-                self.check_non_negative(w, "cz", &cz);
-                RailKind::Elastic { ky, cy, kz, cz }
-            }
-        };
-        let t = raw.table;
-        for (key, v, zero_ok) in [
-            ("y_max", t.y_max, false),
-            ("dy", t.dy, false),
-            ("roll_max", t.roll_max, true),
-            ("droll", t.droll, false),
-        ] {
-            if !(v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0))) {
-                self.err(
-                    w,
-                    Some(key),
-                    None,
-                    format!("table {key} must be positive and finite, got {v}"),
-                );
-            }
-        }
-        let wheels = raw.wheels.map(|(left, right)| {
-            let mut ids = [0; 2];
-            for (k, name) in [left, right].into_iter().enumerate() {
-                ids[k] = match self.body_ref(w, "wheels", name, lookup) {
-                    BodyRef::Body(b) => b,
-                    BodyRef::Ground => {
-                        if name == "ground" {
-                            self.err(
-                                w,
-                                Some("wheels"),
-                                Some(name),
-                                "a wheel must be a body, not ground".into(),
-                            );
-                        }
-                        0
-                    }
-                };
-            }
-            if ids[0] == ids[1] || ids.contains(&wheelset) {
-                self.err(
-                    w,
-                    Some("wheels"),
-                    None,
-                    format!(
-                        "the two wheels (\"{left}\", \"{right}\") must be two different bodies, \
-                         neither of them the wheelset \"{}\" (that is a solid wheelset: omit \
-                         `wheels`)",
-                        raw.wheelset
-                    ),
-                );
-            }
-            ids
-        });
-        let mut e = e.into_iter();
-        let mut next = || e.next().expect("seven values");
-        ForceKind::WheelRail(Box::new(WheelRail {
-            wheelset,
-            wheel_profiles: [paths[0].clone(), paths[1].clone()],
-            rail_profiles: [paths[2].clone(), paths[3].clone()],
-            rail_profiles_inclined: raw.rail_profile_inclined,
-            radius: next(),
-            flange_back_distance: next(),
-            taping_offset: next(),
-            mu: next(),
-            young: next(),
-            poisson: next(),
-            normal_damping: next(),
-            creep,
-            rail,
-            table: ContactTableSpec {
-                y_max: t.y_max,
-                dy: t.dy,
-                roll_max: t.roll_max,
-                droll: t.droll,
-            },
-            wheels,
-        }))
     }
 }
 

@@ -2,8 +2,9 @@
 //! applies to bodies from their kinematics; the system projects them on the
 //! generalized coordinates with the body Jacobians (Q = Σ Γ_jᵀ F_j).
 //!
-//! Adding an element: write its module with a type implementing
-//! [`ForceElement`], and add one arm to [`build`].
+//! Adding an element: write its model syntax and spec in
+//! `railmbs_models::forces`, its module here with a type implementing
+//! [`ForceElement`] built from that spec, and add one arm to [`build`].
 
 mod applied;
 mod bipolar;
@@ -475,7 +476,8 @@ pub fn point_twist_map(rho: &Vector3<f64>) -> SMatrix<f64, 3, 6> {
     s
 }
 
-/// Builds the runtime force elements of a model.
+/// Builds the runtime force elements of a model: the registry, one line per
+/// element, each built from its own model spec.
 pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
     model
         .forces
@@ -483,17 +485,17 @@ pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
         .map(|f| -> Box<dyn ForceElement> {
             let name = f.name.clone();
             match &f.kind {
-                ForceKind::Bipolar { .. } => Box::new(LinearBipolar::new(name, &f.kind)),
-                ForceKind::SeriesSpringDamper { .. } => {
-                    Box::new(SeriesSpringDamper::new(name, &f.kind))
+                ForceKind::Bipolar(spec) => Box::new(LinearBipolar::new(name, spec)),
+                ForceKind::SeriesSpringDamper(spec) => {
+                    Box::new(SeriesSpringDamper::new(name, spec))
                 }
-                ForceKind::Linear6 { .. } => Box::new(Linear6::new(name, &f.kind)),
-                ForceKind::Applied { .. } => Box::new(AppliedForce::new(name, &f.kind)),
-                ForceKind::PointPlane { .. } => Box::new(PointPlane::new(name, &f.kind)),
-                ForceKind::Coulomb { .. } => Box::new(CoulombFriction::new(name, &f.kind)),
-                ForceKind::LoadFriction { .. } => Box::new(LoadFriction::new(name, &f.kind)),
-                ForceKind::Tabulated { .. } => Box::new(Tabulated::new(name, &f.kind)),
+                ForceKind::Linear6(spec) => Box::new(Linear6::new(name, spec)),
+                ForceKind::PointPlane(spec) => Box::new(PointPlane::new(name, spec)),
+                ForceKind::Coulomb(spec) => Box::new(CoulombFriction::new(name, spec)),
+                ForceKind::LoadFriction(spec) => Box::new(LoadFriction::new(name, spec)),
+                ForceKind::Tabulated(spec) => Box::new(Tabulated::new(name, spec)),
                 ForceKind::WheelRail(spec) => Box::new(WheelRailContact::new(name, spec)),
+                ForceKind::Applied(spec) => Box::new(AppliedForce::new(name, spec)),
             }
         })
         .collect()
