@@ -7,7 +7,8 @@
 //!
 //! Adding an element: write its module with a raw type implementing
 //! [`ForceSyntax`] and a spec type implementing [`ForceSpec`], and add one line
-//! to the registry below. The runtime builds its behaviour from the spec
+//! to the registry below (which declares the module and re-exports its public
+//! types here). The runtime builds its behaviour from the spec
 //! (`railmbs_runtime::forces::build`, one line there too).
 
 use crate::expr::Expr;
@@ -15,26 +16,6 @@ use crate::load::{Cx, Lookup, Where};
 pub(crate) use crate::visit::body_ref;
 use serde::de::{self, Deserialize, Deserializer, EnumAccess, MapAccess, VariantAccess, Visitor};
 use std::fmt;
-
-pub mod applied;
-pub mod bipolar;
-pub mod coulomb;
-pub mod linear6;
-pub mod load_friction;
-pub mod point_plane;
-pub mod series_spring;
-pub mod tabulated;
-pub mod wheel_rail;
-
-pub use applied::Applied;
-pub use bipolar::Bipolar;
-pub use coulomb::Coulomb;
-pub use linear6::Linear6;
-pub use load_friction::LoadFriction;
-pub use point_plane::PointPlane;
-pub use series_spring::SeriesSpringDamper;
-pub use tabulated::Tabulated;
-pub use wheel_rail::{ContactTableSpec, CreepLawKind, RailKind, SlidingZoneKind, WheelRail};
 
 /// The model syntax of a force element: what a RON constructor
 /// `Name(name: "…", …)` in a model's `forces` list deserializes to.
@@ -130,11 +111,17 @@ impl<'a> Checks<'a> {
     }
 }
 
-/// The registry: one line per element, `Constructor => Variant(Spec) from Raw`.
+/// The registry: one line per element,
+/// `mod module: Constructor => Variant(Spec) from Raw;`.
 /// It defines [`ForceKind`], the raw enum read from RON and the list of
 /// constructor names the locator uses, so that they cannot drift apart.
 macro_rules! force_elements {
-    ($( $(#[$doc:meta])* $ctor:ident => $variant:ident($spec:ty) from $raw:ty; )*) => {
+    ($( $(#[$doc:meta])* mod $module:ident: $ctor:ident => $variant:ident($spec:ty) from $raw:ident; )*) => {
+        $(
+            pub mod $module;
+            pub use $module::*;
+        )*
+
         /// Force elements of the model. The runtime computes their forces; the
         /// model only describes them. Each variant's fields are expressions
         /// over parameters (and `t` where stated).
@@ -231,26 +218,26 @@ macro_rules! force_elements {
 force_elements! {
     /// Linear bipolar spring–damper between two points (Pogorelov 2005,
     /// Sect. 3.1), see [`Bipolar`].
-    Spring => Bipolar(Bipolar) from bipolar::RawSpring;
+    mod bipolar: Spring => Bipolar(Bipolar) from RawSpring;
     /// Spring in series with a damper between two points (Pogorelov 2005,
     /// Sect. 3.1), see [`SeriesSpringDamper`].
-    SeriesSpring => SeriesSpringDamper(SeriesSpringDamper) from series_spring::RawSeriesSpring;
+    mod series_spring: SeriesSpring => SeriesSpringDamper(SeriesSpringDamper) from RawSeriesSpring;
     /// Generalized linear 6×6 element (Pogorelov 2005, Sect. 3.2), see [`Linear6`].
-    Linear6 => Linear6(Linear6) from linear6::RawLinear6;
+    mod linear6: Linear6 => Linear6(Linear6) from RawLinear6;
     /// Point–plane contact (Pogorelov 2005, Sect. 3.3), see [`PointPlane`].
-    PointPlane => PointPlane(PointPlane) from point_plane::RawPointPlane;
+    mod point_plane: PointPlane => PointPlane(PointPlane) from RawPointPlane;
     /// Bipolar Coulomb friction (Pogorelov 2005, Sect. 3.1), see [`Coulomb`].
-    Coulomb => Coulomb(Coulomb) from coulomb::RawCoulomb;
+    mod coulomb: Coulomb => Coulomb(Coulomb) from RawCoulomb;
     /// Load-dependent friction (Pogorelov 2005, Sect. 3.1, Fig. 3), see
     /// [`LoadFriction`].
-    LoadFriction => LoadFriction(LoadFriction) from load_friction::RawLoadFriction;
+    mod load_friction: LoadFriction => LoadFriction(LoadFriction) from RawLoadFriction;
     /// Tabulated force–deflection characteristic, see [`Tabulated`].
-    Tabulated => Tabulated(Tabulated) from tabulated::RawTabulated;
+    mod tabulated: Tabulated => Tabulated(Tabulated) from RawTabulated;
     /// Wheel–rail contact of a wheelset on the scenario's track (Pogorelov
     /// 2005, Sect. 4), see [`WheelRail`].
-    WheelRail => WheelRail(Box<WheelRail>) from wheel_rail::RawWheelRail;
+    mod wheel_rail: WheelRail => WheelRail(Box<WheelRail>) from RawWheelRail;
     /// An applied force and torque on one body, see [`Applied`].
-    Applied => Applied(Applied) from applied::RawApplied;
+    mod applied: Applied => Applied(Applied) from RawApplied;
 }
 
 /// A RON constructor name (an identifier, so that RON records it for its
