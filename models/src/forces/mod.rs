@@ -238,6 +238,8 @@ force_elements! {
     mod wheel_rail: WheelRail => WheelRail(Box<WheelRail>) from RawWheelRail;
     /// An applied force and torque on one body, see [`Applied`].
     mod applied: Applied => Applied(Applied) from RawApplied;
+    /// Torsion spring–damper about an axis, see [`TorsionSpring`].
+    mod torsion_spring: TorsionSpring => TorsionSpring(TorsionSpring) from RawTorsionSpring;
 }
 
 /// A RON constructor name (an identifier, so that RON records it for its

@@ -13,6 +13,7 @@ mod linear6;
 pub mod nonlinear;
 mod series;
 pub mod sliding_mean;
+pub mod torsion;
 pub mod wheel_rail;
 
 pub use applied::AppliedForce;
@@ -496,6 +497,7 @@ pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
                 ForceKind::Tabulated(spec) => Box::new(Tabulated::new(name, spec)),
                 ForceKind::WheelRail(spec) => Box::new(WheelRailContact::new(name, spec)),
                 ForceKind::Applied(spec) => Box::new(AppliedForce::new(name, spec)),
+                ForceKind::TorsionSpring(spec) => Box::new(torsion::TorsionSpring::new(name, spec)),
             }
         })
         .collect()
