@@ -325,6 +325,7 @@
 
 mod error;
 pub mod expr;
+pub mod forces;
 mod load;
 mod locate;
 mod methods;

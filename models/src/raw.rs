@@ -1,7 +1,8 @@
 //! The RON syntax of model files as serde types, before resolution: names are
 //! still strings and numeric fields are numbers or expression text.
 
-use crate::model::{Axis, CreepLawSpec, Interpolation};
+use crate::forces::RawForce;
+use crate::model::Axis;
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, de::IgnoredAny};
 use std::fmt;
@@ -164,20 +165,18 @@ fn default_gravity() -> Vec3 {
 }
 
 /// An optional number or expression written plainly (no `Some(...)`).
-fn some_value<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Value>, D::Error> {
+pub(crate) fn some_value<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<Value>, D::Error> {
     Value::deserialize(d).map(Some)
 }
 
-fn ground_name() -> String {
+pub(crate) fn ground_name() -> String {
     "ground".into()
 }
 
 pub(crate) fn unit_z() -> Vec3 {
     (Value::Num(0.0), Value::Num(0.0), Value::Num(1.0))
-}
-
-fn zero_matrix() -> RawMatrix6 {
-    RawMatrix6::Diag(Default::default())
 }
 
 #[derive(Debug, Deserialize)]
@@ -426,294 +425,4 @@ pub(crate) struct RawCutJoint {
     #[serde(default = "zero3")]
     pub rotation2: Vec3,
     pub constrain: Vec<RawComponent>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(rename = "Matrix6")]
-pub(crate) enum RawMatrix6 {
-    Diag(Vec6),
-    Full(Vec<Value>),
-    /// A coil spring between its lower and upper plates (frames at the lower
-    /// plate): vertical, shear, bending and torsion stiffness (or damping)
-    /// and the height.
-    VerticalSpring {
-        vertical: Value,
-        shear: Value,
-        bending: Value,
-        torsion: Value,
-        height: Value,
-    },
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename = "Frame")]
-pub(crate) enum RawFrame {
-    #[default]
-    Global,
-    Body,
-}
-
-// Raw syntax lives only while a file is resolved; size does not matter.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Deserialize)]
-#[serde(rename = "Force", deny_unknown_fields)]
-pub(crate) enum RawForce {
-    Spring {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        c: Value,
-        #[serde(default)]
-        d: Value,
-        #[serde(default)]
-        f0: Value,
-        #[serde(default)]
-        x0: Value,
-    },
-    SeriesSpring {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        c: Value,
-        d: Value,
-        #[serde(default)]
-        f0: Value,
-    },
-    Linear6 {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        #[serde(default = "zero3")]
-        rotation1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        #[serde(default = "zero3")]
-        rotation2: Vec3,
-        stiffness: RawMatrix6,
-        #[serde(default = "zero_matrix")]
-        damping: RawMatrix6,
-        #[serde(default)]
-        preload: Vec6,
-    },
-    PointPlane {
-        name: String,
-        body: String,
-        points: Vec<Vec3>,
-        #[serde(default = "ground_name")]
-        plane_body: String,
-        #[serde(default = "zero3")]
-        origin: Vec3,
-        #[serde(default = "unit_z")]
-        normal: Vec3,
-        #[serde(default, deserialize_with = "some_value")]
-        surface: Option<Value>,
-        c: Value,
-        #[serde(default)]
-        d: Value,
-        #[serde(default, deserialize_with = "some_value")]
-        ct: Option<Value>,
-        #[serde(default, deserialize_with = "some_value")]
-        dt: Option<Value>,
-        #[serde(default, deserialize_with = "some_value")]
-        mu0: Option<Value>,
-        #[serde(default)]
-        mu: Value,
-    },
-    Coulomb {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        c: Value,
-        #[serde(default)]
-        d: Value,
-        limit: Value,
-        #[serde(default, deserialize_with = "some_value")]
-        sliding: Option<Value>,
-    },
-    LoadFriction {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        c1: Value,
-        c2: Value,
-        #[serde(default, deserialize_with = "some_value")]
-        mu0: Option<Value>,
-        mu: Value,
-        #[serde(default)]
-        x0: Value,
-    },
-    Tabulated {
-        name: String,
-        body1: String,
-        #[serde(default = "zero3")]
-        point1: Vec3,
-        body2: String,
-        #[serde(default = "zero3")]
-        point2: Vec3,
-        table: Vec<(Value, Value)>,
-        #[serde(default)]
-        interpolation: Interpolation,
-        #[serde(default)]
-        d: Value,
-        #[serde(default)]
-        x0: Value,
-    },
-    WheelRail {
-        name: String,
-        wheelset: String,
-        wheel_profile: String,
-        #[serde(default)]
-        wheel_profile_right: Option<String>,
-        rail_profile: String,
-        #[serde(default)]
-        rail_profile_right: Option<String>,
-        #[serde(default)]
-        rail_profile_inclined: bool,
-        radius: Value,
-        #[serde(default = "default_back_to_back")]
-        flange_back_distance: Value,
-        #[serde(default = "default_taping_offset")]
-        taping_offset: Value,
-        #[serde(default = "default_mu")]
-        mu: Value,
-        #[serde(default = "default_young")]
-        young: Value,
-        #[serde(default = "default_poisson")]
-        poisson: Value,
-        #[serde(default)]
-        normal_damping: Value,
-        #[serde(default)]
-        creep: CreepLawSpec<Value>,
-        #[serde(default)]
-        rail: RawRail,
-        #[serde(default)]
-        table: RawTable,
-        /// Independently rotating wheels: the bodies (left, right) carrying
-        /// each wheel's spin; `None` for a solid wheelset.
-        #[serde(default)]
-        wheels: Option<(String, String)>,
-    },
-    Applied {
-        name: String,
-        body: String,
-        #[serde(default = "zero3")]
-        point: Vec3,
-        #[serde(default = "zero3")]
-        force: Vec3,
-        #[serde(default = "zero3")]
-        torque: Vec3,
-        #[serde(default)]
-        frame: RawFrame,
-    },
-}
-
-impl RawForce {
-    pub(crate) fn name(&self) -> &str {
-        match self {
-            RawForce::Spring { name, .. }
-            | RawForce::Linear6 { name, .. }
-            | RawForce::Applied { name, .. }
-            | RawForce::PointPlane { name, .. }
-            | RawForce::Coulomb { name, .. }
-            | RawForce::SeriesSpring { name, .. }
-            | RawForce::LoadFriction { name, .. }
-            | RawForce::Tabulated { name, .. }
-            | RawForce::WheelRail { name, .. } => name,
-        }
-    }
-}
-
-fn default_back_to_back() -> Value {
-    Value::Num(1.360)
-}
-
-fn default_taping_offset() -> Value {
-    Value::Num(0.070)
-}
-
-fn default_mu() -> Value {
-    Value::Num(0.4)
-}
-
-fn default_young() -> Value {
-    Value::Num(2.1e11)
-}
-
-fn default_poisson() -> Value {
-    Value::Num(0.28)
-}
-
-/// Rails of a `WheelRail` element.
-#[derive(Debug, Default, Deserialize)]
-#[serde(rename = "Rail")]
-pub(crate) enum RawRail {
-    #[default]
-    Rigid,
-    Elastic {
-        ky: Value,
-        #[serde(default)]
-        cy: Value,
-        kz: Value,
-        #[serde(default)]
-        cz: Value,
-    },
-}
-
-/// Contact table grid of a `WheelRail` element (m, rad).
-#[derive(Debug, Deserialize)]
-#[serde(rename = "Table", deny_unknown_fields)]
-pub(crate) struct RawTable {
-    #[serde(default = "default_table_y_max")]
-    pub y_max: f64,
-    #[serde(default = "default_table_dy")]
-    pub dy: f64,
-    #[serde(default = "default_table_roll_max")]
-    pub roll_max: f64,
-    #[serde(default = "default_table_droll")]
-    pub droll: f64,
-}
-
-impl Default for RawTable {
-    fn default() -> Self {
-        RawTable {
-            y_max: default_table_y_max(),
-            dy: default_table_dy(),
-            roll_max: default_table_roll_max(),
-            droll: default_table_droll(),
-        }
-    }
-}
-
-fn default_table_y_max() -> f64 {
-    0.025
-}
-
-fn default_table_dy() -> f64 {
-    0.1e-3
-}
-
-fn default_table_roll_max() -> f64 {
-    0.03
-}
-
-fn default_table_droll() -> f64 {
-    2e-3
 }

@@ -37,7 +37,7 @@ use crate::run::{
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
-use railmbs_models::{BodyRef, Expr, ForceKind, Frame, Model, TrainCoupler, TrainScenario};
+use railmbs_models::{BodyRef, Expr, Frame, Model, TrainCoupler, TrainScenario};
 use std::ops::Range;
 use std::path::Path;
 use std::time::Instant;
@@ -71,7 +71,7 @@ impl Coupler {
             Box::new(m)
         };
         let p = spec.preload;
-        let kind = ForceKind::Linear6 {
+        let kind = railmbs_models::forces::Linear6 {
             body1: BodyRef::Body(0),
             frame1: frame(spec.point1),
             body2: BodyRef::Body(1),

@@ -358,13 +358,13 @@ fn energy_and_dissipation(
     }
     // Constant forces given in SC0 (dead loads): potential −F·r of their point.
     for f in &model.forces {
-        if let ForceKind::Applied {
+        if let ForceKind::Applied(railmbs_models::forces::Applied {
             body,
             point,
             force,
             torque,
             frame: VectorFrame::Global,
-        } = &f.kind
+        }) = &f.kind
         {
             let ev = |e: &[railmbs_models::Expr; 3]| {
                 Vector3::new(

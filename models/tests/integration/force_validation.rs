@@ -28,12 +28,12 @@ fn valid_elements_load_with_defaults() {
     let m = load(&text).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.forces.len(), 5);
     match &m.forces[1].kind {
-        ForceKind::PointPlane {
+        ForceKind::PointPlane(railmbs_models::forces::PointPlane {
             points,
             tangential_stiffness,
             stiffness,
             ..
-        } => {
+        }) => {
             assert_eq!(points.len(), 2);
             // ct defaults to c.
             assert_eq!(tangential_stiffness, stiffness);
@@ -49,12 +49,12 @@ fn valid_elements_load_with_defaults() {
     let m = load(&text).unwrap_or_else(|e| panic!("{e}"));
     match (&m.forces[1].kind, &m.forces[2].kind) {
         (
-            ForceKind::Coulomb {
+            ForceKind::Coulomb(railmbs_models::forces::Coulomb {
                 static_limit,
                 sliding_force,
                 ..
-            },
-            ForceKind::LoadFriction { mu_static, mu, .. },
+            }),
+            ForceKind::LoadFriction(railmbs_models::forces::LoadFriction { mu_static, mu, .. }),
         ) => {
             assert_eq!(static_limit, sliding_force);
             assert_eq!(mu_static, mu);
@@ -207,7 +207,8 @@ fn vertical_spring_helper_gives_the_coil_spring_stiffness() {
     );
     let text = BASE.replacen("c: \"k\"),", &format!("c: \"k\"),\n        {element},"), 1);
     let m = load(&text).unwrap_or_else(|e| panic!("{e}"));
-    let ForceKind::Linear6 { stiffness, .. } = &m.forces[1].kind else {
+    let ForceKind::Linear6(railmbs_models::forces::Linear6 { stiffness, .. }) = &m.forces[1].kind
+    else {
         panic!("{:?}", m.forces[1].kind)
     };
     let c: Vec<f64> = stiffness.iter().map(|e| e.eval(&[], 0.0)).collect();
@@ -241,4 +242,25 @@ fn vertical_spring_helper_gives_the_coil_spring_stiffness() {
     assert!(close(w[1], 0.0) && close(w[3], cb * th), "{w:?}");
     let w = times([0.0, 0.0, u, 0.0, 0.0, th]);
     assert!(close(w[2], cz * u) && close(w[5], ct * th), "{w:?}");
+}
+
+/// `SeriesSpring` was missing from the locator's list of force constructors,
+/// so its errors had no line and column; the list now comes from the force
+/// registry, and its errors point at the field.
+#[test]
+fn series_spring_errors_are_located() {
+    let ss = "SeriesSpring(name: \"ss\", body1: \"a\", body2: \"b\", c: 0, d: 10)";
+    let errors = errors_with(ss);
+    let e = find(&errors, "force \"ss\"", "c must be positive, got 0");
+    let text = BASE.replacen("c: \"k\"),", &format!("c: \"k\"),\n        {ss},"), 1);
+    let at = text.find("c: 0").unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let col = at - text[..at].rfind('\n').map_or(0, |k| k + 1) + 1;
+    assert_eq!(e.position, Some((line, col)));
+    // `find` also checks that the error has a position.
+    find(
+        &errors_with(&ss.replace("d: 10", "d: -1")),
+        "force \"ss\"",
+        "d must be positive",
+    );
 }

@@ -204,7 +204,7 @@ fn force_elements() {
     let p = m.default_parameter_values();
     assert_eq!(m.force_index("bush"), Some(1));
     match &m.forces[0].kind {
-        ForceKind::Bipolar {
+        ForceKind::Bipolar(railmbs_models::forces::Bipolar {
             body1,
             body2,
             stiffness,
@@ -212,7 +212,7 @@ fn force_elements() {
             preload,
             free_length,
             ..
-        } => {
+        }) => {
             assert_eq!(*body1, BodyRef::Ground);
             assert_eq!(*body2, BodyRef::Body(4));
             assert_eq!(stiffness.eval(&p, 0.0), 100.0);
@@ -223,14 +223,14 @@ fn force_elements() {
         other => panic!("{other:?}"),
     }
     match &m.forces[1].kind {
-        ForceKind::Linear6 {
+        ForceKind::Linear6(railmbs_models::forces::Linear6 {
             body1,
             body2,
             stiffness,
             damping,
             preload,
             ..
-        } => {
+        }) => {
             assert_eq!(*body1, BodyRef::Body(2));
             assert_eq!(*body2, BodyRef::Body(3));
             for r in 0..6 {
@@ -252,9 +252,9 @@ fn force_elements() {
         other => panic!("{other:?}"),
     }
     match &m.forces[2].kind {
-        ForceKind::Applied {
+        ForceKind::Applied(railmbs_models::forces::Applied {
             body, force, frame, ..
-        } => {
+        }) => {
             assert_eq!(*body, 4);
             assert!(force[0].has_time());
             assert_eq!(*frame, VectorFrame::Body);
@@ -262,13 +262,13 @@ fn force_elements() {
         other => panic!("{other:?}"),
     }
     match &m.forces[3].kind {
-        ForceKind::Applied {
+        ForceKind::Applied(railmbs_models::forces::Applied {
             point,
             force,
             torque,
             frame,
             ..
-        } => {
+        }) => {
             assert!(point.iter().all(Expr::is_zero));
             assert!(torque.iter().all(Expr::is_zero));
             assert_eq!(force[2].eval(&p, 0.0), -1.0);

@@ -316,13 +316,13 @@ fn forces_reach_subsystem_bodies_and_connection_points() {
     let p = m.default_parameter_values();
     let body = |n: &str| BodyRef::Body(m.body_index(n).unwrap());
     let bipolar = |name: &str| match &m.forces[m.force_index(name).unwrap()].kind {
-        ForceKind::Bipolar {
+        ForceKind::Bipolar(railmbs_models::forces::Bipolar {
             body1,
             point1,
             body2,
             point2,
             ..
-        } => (*body1, eval3(point1, &p), *body2, eval3(point2, &p)),
+        }) => (*body1, eval3(point1, &p), *body2, eval3(point2, &p)),
         other => panic!("{name}: {other:?}"),
     };
     // The vehicle to a bogie's connection point: its body and point.
@@ -341,14 +341,14 @@ fn forces_reach_subsystem_bodies_and_connection_points() {
     assert_eq!((b1, b2), (body("carbody"), body("Absorber.mass")));
     // By long body name.
     match &m.forces[m.force_index("Traction2").unwrap()].kind {
-        ForceKind::Linear6 { body2, frame2, .. } => {
+        ForceKind::Linear6(railmbs_models::forces::Linear6 { body2, frame2, .. }) => {
             assert_eq!(*body2, body("Bogie2.frame"));
             assert_eq!(eval3(&frame2.origin, &p), [0.0, 0.0, 0.25]);
         }
         other => panic!("{other:?}"),
     }
     match &m.forces[m.force_index("Bogie1.Guide2").unwrap()].kind {
-        ForceKind::Linear6 { body1, body2, .. } => {
+        ForceKind::Linear6(railmbs_models::forces::Linear6 { body1, body2, .. }) => {
             assert_eq!(*body1, body("Bogie1.frame"));
             assert_eq!(*body2, body("Bogie1.WS2.axle"));
         }
@@ -559,9 +559,9 @@ fn cut_joints_use_connection_points_and_long_names() {
     assert_eq!(eval3(&c.frame1.origin, &p), [1.0, 1.0, 0.25]);
     // The wheelset's applied force at its own connection point.
     match &m.forces[0].kind {
-        ForceKind::Applied {
+        ForceKind::Applied(railmbs_models::forces::Applied {
             body, point, force, ..
-        } => {
+        }) => {
             assert_eq!(*body, 0);
             assert_eq!(eval3(point, &p), [0.0, 1.0, 0.5]);
             assert_eq!(eval3(force, &p), [0.0, 0.0, -1500.0]);

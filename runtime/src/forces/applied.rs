@@ -6,7 +6,7 @@ use super::{
 };
 use crate::system::SimError;
 use nalgebra::Vector3;
-use railmbs_models::{BodyRef, Expr, ForceKind, VectorFrame};
+use railmbs_models::{BodyRef, Expr, VectorFrame};
 
 /// A force (N) at a body point and a torque (N m), given in SC0 or in the body
 /// frame, each component an expression that may depend on time.
@@ -20,18 +20,15 @@ pub struct AppliedForce {
 }
 
 impl AppliedForce {
-    /// From a model's `ForceKind::Applied`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Applied {
+    /// From the model's `Applied` spec (`railmbs_models::forces::Applied`).
+    pub fn new(name: String, spec: &railmbs_models::forces::Applied) -> Self {
+        let railmbs_models::forces::Applied {
             body,
             point,
             force,
             torque,
             frame,
-        } = kind
-        else {
-            unreachable!("AppliedForce::new takes an Applied element")
-        };
+        } = spec;
         Self {
             name,
             point: Attachment::new(BodyRef::Body(*body), point),

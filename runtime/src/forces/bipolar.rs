@@ -7,7 +7,7 @@ use super::{
 };
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{BodyRef, Expr, ForceKind};
+use railmbs_models::{BodyRef, Expr};
 
 /// Two attachment points and the kinematics of their distance.
 #[derive(Debug, Clone)]
@@ -134,9 +134,9 @@ pub struct LinearBipolar {
 }
 
 impl LinearBipolar {
-    /// From a model's `ForceKind::Bipolar`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Bipolar {
+    /// From the model's `Bipolar` spec (`railmbs_models::forces::Bipolar`).
+    pub fn new(name: String, spec: &railmbs_models::forces::Bipolar) -> Self {
+        let railmbs_models::forces::Bipolar {
             body1,
             point1,
             body2,
@@ -145,10 +145,7 @@ impl LinearBipolar {
             damping,
             preload,
             free_length,
-        } = kind
-        else {
-            unreachable!("LinearBipolar::new takes a Bipolar element")
-        };
+        } = spec;
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),

@@ -31,7 +31,7 @@ use super::{
 };
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{BodyRef, Expr, ForceKind};
+use railmbs_models::{BodyRef, Expr};
 
 /// Normal stiffness c (N/m) and damping d (N s/m) that make a mass m (kg)
 /// resting on a linear contact vibrate at `frequency` (Hz) with the damping
@@ -132,9 +132,9 @@ struct PointEval {
 }
 
 impl PointPlane {
-    /// From a model's `ForceKind::PointPlane`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::PointPlane {
+    /// From the model's `PointPlane` spec (`railmbs_models::forces::PointPlane`).
+    pub fn new(name: String, spec: &railmbs_models::forces::PointPlane) -> Self {
+        let railmbs_models::forces::PointPlane {
             body,
             points,
             plane_body,
@@ -147,10 +147,7 @@ impl PointPlane {
             tangential_damping,
             mu_static,
             mu,
-        } = kind
-        else {
-            unreachable!("PointPlane::new takes a PointPlane element")
-        };
+        } = spec;
         Self {
             name,
             points: points.iter().map(|p| Attachment::new(*body, p)).collect(),

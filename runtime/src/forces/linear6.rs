@@ -6,7 +6,7 @@ use super::{
 };
 use crate::system::SimError;
 use nalgebra::{Matrix6, Vector3, Vector6};
-use railmbs_models::{Expr, ForceKind};
+use railmbs_models::Expr;
 
 /// Linear element between frame 1 (on body 1) and frame 2 (on body 2).
 ///
@@ -32,9 +32,9 @@ pub struct Linear6 {
 }
 
 impl Linear6 {
-    /// From a model's `ForceKind::Linear6`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Linear6 {
+    /// From the model's `Linear6` spec (`railmbs_models::forces::Linear6`).
+    pub fn new(name: String, spec: &railmbs_models::forces::Linear6) -> Self {
+        let railmbs_models::forces::Linear6 {
             body1,
             frame1,
             body2,
@@ -42,10 +42,7 @@ impl Linear6 {
             stiffness,
             damping,
             preload,
-        } = kind
-        else {
-            unreachable!("Linear6::new takes a Linear6 element")
-        };
+        } = spec;
         Self {
             name,
             frames: [

@@ -25,7 +25,7 @@ use super::bipolar::TwoPoint;
 use super::{ForceContext, ForceElement, ForceJacobian, Wrench, eval_scalar};
 use crate::system::SimError;
 
-use railmbs_models::{Expr, ForceKind, Interpolation};
+use railmbs_models::{Expr, Interpolation};
 
 /// Velocity below which the sign of the sliding velocity is regularized
 /// linearly, m/s.
@@ -90,9 +90,9 @@ enum Branch {
 }
 
 impl CoulombFriction {
-    /// From a model's `ForceKind::Coulomb`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Coulomb {
+    /// From the model's `Coulomb` spec (`railmbs_models::forces::Coulomb`).
+    pub fn new(name: String, spec: &railmbs_models::forces::Coulomb) -> Self {
+        let railmbs_models::forces::Coulomb {
             body1,
             point1,
             body2,
@@ -101,10 +101,7 @@ impl CoulombFriction {
             damping,
             static_limit,
             sliding_force,
-        } = kind
-        else {
-            unreachable!("CoulombFriction::new takes a Coulomb element")
-        };
+        } = spec;
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),
@@ -287,9 +284,9 @@ pub struct LoadFriction {
 }
 
 impl LoadFriction {
-    /// From a model's `ForceKind::LoadFriction`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::LoadFriction {
+    /// From the model's `LoadFriction` spec (`railmbs_models::forces::LoadFriction`).
+    pub fn new(name: String, spec: &railmbs_models::forces::LoadFriction) -> Self {
+        let railmbs_models::forces::LoadFriction {
             body1,
             point1,
             body2,
@@ -299,10 +296,7 @@ impl LoadFriction {
             mu_static,
             mu,
             free_length,
-        } = kind
-        else {
-            unreachable!("LoadFriction::new takes a LoadFriction element")
-        };
+        } = spec;
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),
@@ -634,9 +628,9 @@ pub struct Tabulated {
 }
 
 impl Tabulated {
-    /// From a model's `ForceKind::Tabulated`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::Tabulated {
+    /// From the model's `Tabulated` spec (`railmbs_models::forces::Tabulated`).
+    pub fn new(name: String, spec: &railmbs_models::forces::Tabulated) -> Self {
+        let railmbs_models::forces::Tabulated {
             body1,
             point1,
             body2,
@@ -645,10 +639,7 @@ impl Tabulated {
             interpolation,
             damping,
             free_length,
-        } = kind
-        else {
-            unreachable!("Tabulated::new takes a Tabulated element")
-        };
+        } = spec;
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),

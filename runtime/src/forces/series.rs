@@ -18,7 +18,7 @@
 use super::bipolar::{PairState, TwoPoint};
 use super::{ForceContext, ForceElement, ForceJacobian, Wrench, eval_scalar};
 use crate::system::SimError;
-use railmbs_models::{Expr, ForceKind};
+use railmbs_models::Expr;
 
 /// A spring in series with a damper (Maxwell element) plus a parallel preload.
 #[derive(Debug, Clone)]
@@ -37,9 +37,9 @@ pub struct SeriesSpringDamper {
 }
 
 impl SeriesSpringDamper {
-    /// From a model's `ForceKind::SeriesSpringDamper`.
-    pub fn new(name: String, kind: &ForceKind) -> Self {
-        let ForceKind::SeriesSpringDamper {
+    /// From the model's `SeriesSpringDamper` spec (`railmbs_models::forces::SeriesSpringDamper`).
+    pub fn new(name: String, spec: &railmbs_models::forces::SeriesSpringDamper) -> Self {
+        let railmbs_models::forces::SeriesSpringDamper {
             body1,
             point1,
             body2,
@@ -47,10 +47,7 @@ impl SeriesSpringDamper {
             stiffness,
             damping,
             preload,
-        } = kind
-        else {
-            unreachable!("SeriesSpringDamper::new takes a SeriesSpringDamper element")
-        };
+        } = spec;
         Self {
             name,
             pair: TwoPoint::new(*body1, point1, *body2, point2),

@@ -1,0 +1,455 @@
+//! `WheelRail`: wheel–rail contact of a wheelset on the scenario's track
+//! (Pogorelov 2005, Sect. 4).
+
+use super::{Checks, ForceSpec, ForceSyntax};
+use crate::expr::Expr;
+use crate::load::{Cx, Lookup, Where};
+use crate::model::BodyRef;
+use crate::raw::Value;
+use railmbs_wheelrail::creep::CreepLawSpec;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Wheel–rail contact of a wheelset on the scenario's track (Pogorelov 2005,
+/// Sect. 4): left and right wheel against their rails, contact geometry
+/// from a table over lateral shift and roll, Hertzian normal force, creep
+/// forces by the chosen law. The wheelset body's frame has its origin at
+/// the axle centre and its y axis along the axle (to the left); its spin
+/// about y may be a coordinate or not (then the wheels' rolling speed is
+/// that of the body's angular velocity anyway).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WheelRail {
+    /// The wheelset body.
+    pub wheelset: usize,
+    /// Wheel profiles (left, right; the right one mirrored when placed),
+    /// absolute paths.
+    pub wheel_profiles: [PathBuf; 2],
+    /// Rail profiles (left, right), absolute paths. The track's rail
+    /// inclination is applied when they are read, unless
+    /// `rail_profiles_inclined`.
+    pub rail_profiles: [PathBuf; 2],
+    /// The rail profile files are already drawn inclined (as the Manchester
+    /// benchmark's UIC60 files are): the track's rail inclination is not
+    /// applied again.
+    pub rail_profiles_inclined: bool,
+    /// Nominal rolling radius at the taping line, m.
+    pub radius: Expr,
+    /// Distance between the flange backs, m.
+    pub flange_back_distance: Expr,
+    /// Distance from a flange back to the taping line, m.
+    pub taping_offset: Expr,
+    /// Coefficient of friction, –.
+    pub mu: Expr,
+    /// Young's modulus of wheel and rail, Pa.
+    pub young: Expr,
+    /// Poisson's ratio of wheel and rail, –.
+    pub poisson: Expr,
+    /// Damping along the contact normal, N s/m (0: none).
+    pub normal_damping: Expr,
+    /// The creep-force law and its settings (expressions over parameters).
+    pub creep: CreepLawSpec<Expr>,
+    /// Rigid rails, or massless elastic rails (Pogorelov 2005, Sect. 4.2).
+    pub rail: RailKind,
+    /// Contact table ranges and steps.
+    pub table: ContactTableSpec,
+    /// Independently rotating wheels: the bodies (left, right) that carry
+    /// each wheel's spin, usually on revolute joints about the axle's y axis.
+    /// Each wheel's contact forces act on its own body and its creepages come
+    /// from that body's velocity and angular velocity; the contact geometry
+    /// still follows the `wheelset` (axle) body's pose. `None`: a solid
+    /// wheelset, both wheels on the `wheelset` body.
+    pub wheels: Option<[usize; 2]>,
+}
+
+/// The rails of a wheel–rail element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RailKind {
+    /// Rails fixed to the track.
+    Rigid,
+    /// Massless rail heads on lateral and vertical spring–dampers (per rail):
+    /// N/m, N s/m.
+    Elastic {
+        ky: Expr,
+        cy: Expr,
+        kz: Expr,
+        cz: Expr,
+    },
+}
+
+/// Contact table grid: lateral shift in [−y_max, y_max] by dy, roll in
+/// [−roll_max, roll_max] by droll (m, rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactTableSpec {
+    pub y_max: f64,
+    pub dy: f64,
+    pub roll_max: f64,
+    pub droll: f64,
+}
+
+/// `WheelRail(name, wheelset, wheel_profile, …, creep, rail, table, wheels)`.
+#[derive(Debug, Deserialize)]
+#[serde(rename = "WheelRail", deny_unknown_fields)]
+pub(crate) struct RawWheelRail {
+    name: String,
+    wheelset: String,
+    wheel_profile: String,
+    #[serde(default)]
+    wheel_profile_right: Option<String>,
+    rail_profile: String,
+    #[serde(default)]
+    rail_profile_right: Option<String>,
+    #[serde(default)]
+    rail_profile_inclined: bool,
+    radius: Value,
+    #[serde(default = "default_back_to_back")]
+    flange_back_distance: Value,
+    #[serde(default = "default_taping_offset")]
+    taping_offset: Value,
+    #[serde(default = "default_mu")]
+    mu: Value,
+    #[serde(default = "default_young")]
+    young: Value,
+    #[serde(default = "default_poisson")]
+    poisson: Value,
+    #[serde(default)]
+    normal_damping: Value,
+    #[serde(default)]
+    creep: CreepLawSpec<Value>,
+    #[serde(default)]
+    rail: RawRail,
+    #[serde(default)]
+    table: RawTable,
+    /// Independently rotating wheels: the bodies (left, right) carrying
+    /// each wheel's spin; `None` for a solid wheelset.
+    #[serde(default)]
+    wheels: Option<(String, String)>,
+}
+
+impl ForceSyntax for RawWheelRail {
+    type Spec = Box<WheelRail>;
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn resolve(&self, cx: &mut Cx, w: &Where, lookup: &Lookup) -> Box<WheelRail> {
+        wheel_rail(
+            cx,
+            w,
+            lookup,
+            WheelRailRaw {
+                wheelset: &self.wheelset,
+                profiles: [
+                    ("wheel_profile", Some(&self.wheel_profile)),
+                    ("wheel_profile_right", self.wheel_profile_right.as_ref()),
+                    ("rail_profile", Some(&self.rail_profile)),
+                    ("rail_profile_right", self.rail_profile_right.as_ref()),
+                ],
+                values: [
+                    ("radius", &self.radius),
+                    ("flange_back_distance", &self.flange_back_distance),
+                    ("taping_offset", &self.taping_offset),
+                    ("mu", &self.mu),
+                    ("young", &self.young),
+                    ("poisson", &self.poisson),
+                    ("normal_damping", &self.normal_damping),
+                ],
+                rail_profile_inclined: self.rail_profile_inclined,
+                creep: &self.creep,
+                rail: &self.rail,
+                table: &self.table,
+                wheels: self.wheels.as_ref(),
+            },
+        )
+    }
+}
+
+fn default_back_to_back() -> Value {
+    Value::Num(1.360)
+}
+
+fn default_taping_offset() -> Value {
+    Value::Num(0.070)
+}
+
+fn default_mu() -> Value {
+    Value::Num(0.4)
+}
+
+fn default_young() -> Value {
+    Value::Num(2.1e11)
+}
+
+fn default_poisson() -> Value {
+    Value::Num(0.28)
+}
+
+/// Rails of a `WheelRail` element.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename = "Rail")]
+pub(crate) enum RawRail {
+    #[default]
+    Rigid,
+    Elastic {
+        ky: Value,
+        #[serde(default)]
+        cy: Value,
+        kz: Value,
+        #[serde(default)]
+        cz: Value,
+    },
+}
+
+/// Contact table grid of a `WheelRail` element (m, rad).
+#[derive(Debug, Deserialize)]
+#[serde(rename = "Table", deny_unknown_fields)]
+pub(crate) struct RawTable {
+    #[serde(default = "default_table_y_max")]
+    pub y_max: f64,
+    #[serde(default = "default_table_dy")]
+    pub dy: f64,
+    #[serde(default = "default_table_roll_max")]
+    pub roll_max: f64,
+    #[serde(default = "default_table_droll")]
+    pub droll: f64,
+}
+
+impl Default for RawTable {
+    fn default() -> Self {
+        RawTable {
+            y_max: default_table_y_max(),
+            dy: default_table_dy(),
+            roll_max: default_table_roll_max(),
+            droll: default_table_droll(),
+        }
+    }
+}
+
+fn default_table_y_max() -> f64 {
+    0.025
+}
+
+fn default_table_dy() -> f64 {
+    0.1e-3
+}
+
+fn default_table_roll_max() -> f64 {
+    0.03
+}
+
+fn default_table_droll() -> f64 {
+    2e-3
+}
+
+/// The fields of a raw `WheelRail` element, borrowed for resolution.
+struct WheelRailRaw<'r> {
+    wheelset: &'r str,
+    /// (key, path text): wheel left/right, rail left/right.
+    profiles: [(&'static str, Option<&'r String>); 4],
+    /// (key, value): radius, flange_back_distance, taping_offset, mu, young,
+    /// poisson, normal_damping.
+    values: [(&'static str, &'r Value); 7],
+    rail_profile_inclined: bool,
+    creep: &'r CreepLawSpec<Value>,
+    rail: &'r RawRail,
+    table: &'r RawTable,
+    /// Independently rotating wheels' bodies (left, right), if any.
+    wheels: Option<&'r (String, String)>,
+}
+
+/// Resolves a wheel–rail element: the wheelset body, profile files (paths
+/// relative to the model file, which must exist; stored canonical), material and friction
+/// values (checked with the defaults), the creep law, rails and table grid.
+fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box<WheelRail> {
+    let wheelset = match cx.body_ref(w, "wheelset", raw.wheelset, lookup) {
+        BodyRef::Body(k) => k,
+        BodyRef::Ground => {
+            if raw.wheelset == "ground" {
+                cx.err(
+                    w,
+                    Some("wheelset"),
+                    None,
+                    "the wheelset must be a body, not ground".into(),
+                );
+            }
+            0
+        }
+    };
+    let base = cx.file.parent().unwrap_or(Path::new("."));
+    let mut paths: Vec<PathBuf> = Vec::with_capacity(4);
+    for (k, (key, text)) in raw.profiles.iter().enumerate() {
+        // A missing right-hand profile is the left one (mirrored when placed).
+        let Some(text) = text.or(raw.profiles[k - k % 2].1) else {
+            paths.push(PathBuf::new());
+            continue;
+        };
+        let path = base.join(text);
+        if text.is_empty() || !path.is_file() {
+            cx.err(
+                w,
+                Some(key),
+                Some(text),
+                format!("profile file not found: {}", path.display()),
+            );
+        }
+        // Absolute, so that the resolved model does not depend on the
+        // working directory (nor on which file included this one).
+        paths.push(std::fs::canonicalize(&path).unwrap_or(path));
+    }
+    let e: Vec<Expr> = raw
+        .values
+        .iter()
+        .map(|(key, v)| cx.expr(w, key, key, v, false))
+        .collect();
+    let creep = raw
+        .creep
+        .map(|key, v| cx.expr(w, &format!("creep.{key}"), key, v, false));
+    let rail = match raw.rail {
+        RawRail::Rigid => RailKind::Rigid,
+        RawRail::Elastic { ky, cy, kz, cz } => {
+            let ky = cx.expr(w, "rail.ky", "ky", ky, false);
+            let cy = cx.expr(w, "rail.cy", "cy", cy, false);
+            let kz = cx.expr(w, "rail.kz", "kz", kz, false);
+            let cz = cx.expr(w, "rail.cz", "cz", cz, false);
+            RailKind::Elastic { ky, cy, kz, cz }
+        }
+    };
+    let t = raw.table;
+    for (key, v, zero_ok) in [
+        ("y_max", t.y_max, false),
+        ("dy", t.dy, false),
+        ("roll_max", t.roll_max, true),
+        ("droll", t.droll, false),
+    ] {
+        if !(v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0))) {
+            cx.err(
+                w,
+                Some(key),
+                None,
+                format!("table {key} must be positive and finite, got {v}"),
+            );
+        }
+    }
+    let wheels = raw.wheels.map(|(left, right)| {
+        let mut ids = [0; 2];
+        for (k, name) in [left, right].into_iter().enumerate() {
+            ids[k] = match cx.body_ref(w, "wheels", name, lookup) {
+                BodyRef::Body(b) => b,
+                BodyRef::Ground => {
+                    if name == "ground" {
+                        cx.err(
+                            w,
+                            Some("wheels"),
+                            Some(name),
+                            "a wheel must be a body, not ground".into(),
+                        );
+                    }
+                    0
+                }
+            };
+        }
+        if ids[0] == ids[1] || ids.contains(&wheelset) {
+            cx.err(
+                w,
+                Some("wheels"),
+                None,
+                format!(
+                    "the two wheels (\"{left}\", \"{right}\") must be two different bodies, \
+                     neither of them the wheelset \"{}\" (that is a solid wheelset: omit \
+                     `wheels`)",
+                    raw.wheelset
+                ),
+            );
+        }
+        ids
+    });
+    let mut e = e.into_iter();
+    let mut next = || e.next().expect("seven values");
+    Box::new(WheelRail {
+        wheelset,
+        wheel_profiles: [paths[0].clone(), paths[1].clone()],
+        rail_profiles: [paths[2].clone(), paths[3].clone()],
+        rail_profiles_inclined: raw.rail_profile_inclined,
+        radius: next(),
+        flange_back_distance: next(),
+        taping_offset: next(),
+        mu: next(),
+        young: next(),
+        poisson: next(),
+        normal_damping: next(),
+        creep,
+        rail,
+        table: ContactTableSpec {
+            y_max: t.y_max,
+            dy: t.dy,
+            roll_max: t.roll_max,
+            droll: t.droll,
+        },
+        wheels,
+    })
+}
+
+impl ForceSpec for WheelRail {
+    fn exprs_mut(&mut self, f: &mut dyn FnMut(&mut Expr)) {
+        let WheelRail {
+            radius,
+            flange_back_distance,
+            taping_offset,
+            mu,
+            young,
+            poisson,
+            normal_damping,
+            creep,
+            rail,
+            ..
+        } = self;
+        for e in [
+            radius,
+            flange_back_distance,
+            taping_offset,
+            mu,
+            young,
+            poisson,
+            normal_damping,
+        ] {
+            f(e);
+        }
+        creep.for_each_value_mut(|_, e| f(e));
+        match rail {
+            RailKind::Elastic { ky, cy, kz, cz } => {
+                for e in [ky, cy, kz, cz] {
+                    f(e);
+                }
+            }
+            RailKind::Rigid => {}
+        }
+    }
+    fn bodies_mut(&mut self, f: &mut dyn FnMut(&mut usize)) {
+        f(&mut self.wheelset);
+        if let Some(wheels) = &mut self.wheels {
+            wheels.iter_mut().for_each(&mut *f);
+        }
+    }
+    fn check(&self, c: &mut Checks) {
+        c.positive("radius", &self.radius);
+        c.positive("flange_back_distance", &self.flange_back_distance);
+        c.positive("young", &self.young);
+        c.non_negative("taping_offset", &self.taping_offset);
+        c.non_negative("mu", &self.mu);
+        c.non_negative("normal_damping", &self.normal_damping);
+        let nu = c.value(&self.poisson);
+        if nu.is_finite() && !(0.0..=0.5).contains(&nu) {
+            c.push("poisson", format!("poisson must be in [0, 0.5], got {nu}"));
+        }
+        // The law's own checks, its settings at these parameter values (1 where
+        // not finite: counts and ranges are checked all the same).
+        let law = self.creep.map(|_, e| Some(c.value(e)).filter(|x| x.is_finite()).unwrap_or(1.0));
+        if let Err(e) = law.validate() {
+            c.push("creep", e.to_string());
+        }
+        if let RailKind::Elastic { ky, cy, kz, cz } = &self.rail {
+            c.positive("ky", ky);
+            c.positive("kz", kz);
+            c.non_negative("cy", cy);
+            c.non_negative("cz", cz);
+        }
+    }
+}
