@@ -225,7 +225,7 @@ fn time_eval(
         }
         best = best.min(t.elapsed() / reps);
     }
-    // Rust cdylibs are never unloaded (DESIGN.md).
+    // Rust cdylibs are never unloaded (docs/design.md).
     std::mem::forget(lib);
     Ok((best, result))
 }

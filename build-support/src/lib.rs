@@ -78,7 +78,7 @@
 //! - **The front end dominates** a split build: `--emit=metadata` (parse, type and borrow
 //!   check) alone takes 2.2 s CPU of the 3.6 s; the whole build at opt-level 0 takes 2.6 s.
 //! - **opt-level** 1, 2 and 3 run this straight-line scalar code equally fast (±5 %, the
-//!   noise); 3 costs ~12 % more compile time. 2 is the default, as DESIGN.md prescribes.
+//!   noise); 3 costs ~12 % more compile time. 2 is the default, as docs/design.md prescribes.
 //! - **codegen-units** does not change CPU time or run time for split code; in paired runs
 //!   (same source, alternating, three times) 16 units cut wall time from 6.9 / 7.1 / 4.3 s to
 //!   5.2 / 6.4 / 3.2 s because LLVM's share runs on both cores. Hence the default

@@ -26,7 +26,7 @@ fn call_add(path: &Path, a: f64, b: f64) -> f64 {
             .get::<unsafe extern "C" fn(f64, f64) -> f64>(b"add")
             .expect("symbol add");
         let r = add(a, b);
-        // Rust cdylibs must not be unloaded (DESIGN.md, plugin boundary): keep it mapped.
+        // Rust cdylibs must not be unloaded (docs/design.md, plugin boundary): keep it mapped.
         std::mem::forget(lib);
         r
     }

@@ -4,7 +4,7 @@
 //! Convention: `rot_x(a)`, `rot_y(a)`, `rot_z(a)` are the direction cosine matrices of a frame
 //! rotated by the angle `a` (rad, right-handed) about the x, y, z axis of its parent frame:
 //! they map coordinates in the rotated frame to coordinates in the parent frame
-//! (`r_parent = A · r_body`), as in the seed paper's recursive kinematics.
+//! (`r_parent = A · r_body`), as in the recursive kinematics of Pogorelov 2005, Sect. 2.1.
 
 use crate::graph::{Context, ExprId, ONE, ZERO};
 

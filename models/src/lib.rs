@@ -92,7 +92,7 @@
 //! ### Friction, contact and nonlinear force elements
 //!
 //! Besides `Spring`, `Linear6` and `Applied` (above), `forces` accepts the
-//! elements of the seed paper's Sect. 3 (fields with a default may be left out;
+//! elements of Pogorelov 2005, Sect. 3 (fields with a default may be left out;
 //! every number may be an expression over parameters):
 //!
 //! ```text
@@ -182,7 +182,7 @@
 //!
 //! ### Subsystems and connection points
 //!
-//! A model file may include other model files as subsystems (seed paper
+//! A model file may include other model files as subsystems (Pogorelov 2005,
 //! Sect. 5): one wheelset file and one bogie file serve every vehicle that
 //! uses them. Two optional top-level fields:
 //!

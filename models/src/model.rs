@@ -3,7 +3,7 @@
 //! RON file; every name is resolved to an index and every numeric field is an
 //! [`Expr`] over the model's identifiers (parameters) and, where allowed, time.
 //!
-//! Conventions (see DESIGN.md): SI units; a body frame has its origin at the
+//! Conventions (see docs/design.md): SI units; a body frame has its origin at the
 //! body's centre of mass; a joint is an ordered list of elementary
 //! transformations from the parent's body frame to the child's body frame.
 
@@ -186,7 +186,7 @@ pub struct Macro {
     pub assignments: Vec<(usize, Expr)>,
 }
 
-/// A track-following frame (DESIGN.md): a frame moving along the track with
+/// A track-following frame (docs/design.md): a frame moving along the track with
 /// the vehicle, at arc position s(t) + `offset`. Its pose enters the equations as
 /// six runtime inputs (x, y, z in SC0, then yaw, pitch, roll applied in that
 /// order: Rz·Ry·Rx), so curves, transitions and cant add the right centrifugal and

@@ -1,5 +1,5 @@
 //! Park's method on a stiff model with many frictional contacts, with the
-//! analytic approximate Jacobian (seed paper Sect. 6: local Jacobians of the
+//! analytic approximate Jacobian (Pogorelov 2005, Sect. 6: local Jacobians of the
 //! force elements mapped by the point Jacobians) against the finite-difference
 //! Jacobian (2n extra `dynamics` calls per Jacobian), same tolerances.
 //!

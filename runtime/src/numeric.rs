@@ -1,7 +1,7 @@
 //! The numeric-iterative engine: evaluates the recursive kinematics and the
 //! equations of motion of a [`Model`] at every call, with no code generation.
 //!
-//! Kinematics (seed paper Sect. 2.1): every joint is a chain of elementary
+//! Kinematics (Pogorelov 2005, Sect. 2.1): every joint is a chain of elementary
 //! transformations; walking them from SC0 outwards gives each frame's position
 //! r, direction cosines A, velocity v, angular velocity ω and the "bias"
 //! accelerations a⁰, α⁰ (the accelerations at q̈ = 0). For a translation d = A e s

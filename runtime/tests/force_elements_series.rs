@@ -1,4 +1,4 @@
-//! Stiffness and damping in series (a Maxwell element, seed paper Sect. 3.1):
+//! Stiffness and damping in series (a Maxwell element, Pogorelov 2005, Sect. 3.1):
 //! its first-order state integrated by Park's method together with q, against
 //! the closed-form solution of the linear third-order system, the energy
 //! balance of the damper, and its Jacobian against central differences.

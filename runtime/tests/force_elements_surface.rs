@@ -1,4 +1,4 @@
-//! Point–Z-surface contact (seed paper Sect. 3.3, the surface z = f(x, y)
+//! Point–Z-surface contact (Pogorelov 2005, Sect. 3.3, the surface z = f(x, y)
 //! given as an expression): a bead sliding without friction in a bowl swings
 //! with the pendulum period of the bowl's radius of curvature; a planar
 //! surface gives the same forces and Jacobians as the equivalent point–plane

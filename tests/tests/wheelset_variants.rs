@@ -1,4 +1,4 @@
-//! Wheelset variants: massless elastic rails (seed paper Sect. 4.2) and
+//! Wheelset variants: massless elastic rails (Pogorelov 2005, Sect. 4.2) and
 //! independently rotating wheels, against physics.
 
 mod common;

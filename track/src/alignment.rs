@@ -1,7 +1,7 @@
 //! Horizontal alignment: a chain of straights, clothoid transitions and circular
 //! curves, each with a linear cant ramp.
 //!
-//! Conventions (DESIGN.md): SC0 has x forward along the start of the track, y to
+//! Conventions (docs/design.md): SC0 has x forward along the start of the track, y to
 //! the left, z up. `s` is the arc length of the horizontal (plan) centre line, m.
 //! The heading ψ(s) is the angle from SC0's x axis to the tangent, positive
 //! counter-clockwise seen from above, rad. The **signed curvature** κ = dψ/ds is

@@ -1,6 +1,6 @@
 //! Track cases: data plus documented choices.
 //!
-//! Public sources (the seed paper; `../shared/reference/README.md`) give only
+//! Public sources (Pogorelov 2005; `../shared/reference/README.md`) give only
 //! the headline data of the Manchester benchmark track cases; everything else
 //! here (transition lengths, lead-in, dip length, sinusoid wavelength and
 //! amplitude) is our choice, stated per case. All use standard gauge 1.435 m,

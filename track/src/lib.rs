@@ -18,7 +18,7 @@
 //! - [`cases`]: the track cases of the Manchester benchmark and others;
 //! - [`spec`]: serde descriptions of tracks (for RON scenario files).
 //!
-//! Conventions (DESIGN.md): SI units; SC0 x forward along the start of the
+//! Conventions (docs/design.md): SI units; SC0 x forward along the start of the
 //! track, y left, z up; s is the plan arc length; signed curvature κ > 0 turns
 //! left; signed cant h = z(left rail) − z(right rail).
 

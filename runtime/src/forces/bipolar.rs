@@ -1,6 +1,6 @@
 //! Two-point (bipolar) elements: the geometry shared by every element acting
 //! along the line of two points ([`TwoPoint`]), and the linear viscoelastic
-//! element (seed paper Sect. 3.1).
+//! element (Pogorelov 2005, Sect. 3.1).
 
 use super::{
     Attachment, ForceContext, ForceElement, ForceJacobian, Wrench, add_force, eval_scalar,

@@ -1,4 +1,4 @@
-//! Point–plane contact with Coulomb friction (seed paper Sect. 3.3).
+//! Point–plane contact with Coulomb friction (Pogorelov 2005, Sect. 3.3).
 //!
 //! Points fixed to one body touch a plane fixed to another body (or the
 //! ground). For a point P, the plane through O with outward unit normal n

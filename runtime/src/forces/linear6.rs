@@ -1,4 +1,4 @@
-//! Generalized linear 6×6 elastic and dissipative element (seed paper Sect. 3.2).
+//! Generalized linear 6×6 elastic and dissipative element (Pogorelov 2005, Sect. 3.2).
 
 use super::{
     Characteristic, ForceContext, ForceElement, ForceJacobian, FrameAttachment, Wrench, add_force,

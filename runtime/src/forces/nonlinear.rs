@@ -1,4 +1,4 @@
-//! Nonlinear bipolar elements (seed paper Sect. 3.1): Coulomb friction with
+//! Nonlinear bipolar elements (Pogorelov 2005, Sect. 3.1): Coulomb friction with
 //! sticking and sliding, load-dependent friction (Fig. 3) and tabulated
 //! force–deflection characteristics (bump stops).
 //!

@@ -1,4 +1,4 @@
-//! Stiffness and damping in series (seed paper Sect. 3.1): a spring c and a
+//! Stiffness and damping in series (Pogorelov 2005, Sect. 3.1): a spring c and a
 //! damper d connected end to end between two points, with a preload f0 in
 //! parallel. The massless node between them gives the element a first-order
 //! state, the spring's extension s (m):

@@ -1,5 +1,5 @@
-//! Wheel–rail contact of one wheelset on the scenario's track (seed paper
-//! Sect. 4; DESIGN.md "Wheel–rail contact").
+//! Wheel–rail contact of one wheelset on the scenario's track (Pogorelov 2005,
+//! Sect. 4; docs/design.md "Wheel–rail contact").
 //!
 //! Per evaluation, for a wheelset body whose track-following frame sits at arc
 //! position s:
@@ -29,7 +29,7 @@
 //! 5. the Hertz ellipse and the creep forces by the chosen law; on the wheel:
 //!    N n + Fx eₓ + Fy eᵧ at the contact point and the spin moment Mz n.
 //!
-//! **Elastic rails** (`rail: Elastic(ky, cy, kz, cz)`, seed paper Sect. 4.2):
+//! **Elastic rails** (`rail: Elastic(ky, cy, kz, cz)`, Pogorelov 2005, Sect. 4.2):
 //! each rail head is massless and moves laterally and vertically, by
 //! d = (d_y, d_z) in the track's cross-section, against a spring–damper to
 //! ground. At every force evaluation and for each rail,
@@ -680,7 +680,7 @@ impl WheelRailContact {
         }
     }
 
-    /// One side on its massless elastic rail (seed paper Sect. 4.2, via
+    /// One side on its massless elastic rail (Pogorelov 2005, Sect. 4.2, via
     /// [`elastic_rail::solve_from`]): the rail displacement and the normal
     /// and creep forces in equilibrium, written into `state`; `start` is
     /// (h, d_prev, creep) of [`Self::rail_reference`] for this rail.
@@ -1021,7 +1021,7 @@ impl ForceElement for WheelRailContact {
                     r.cy, r.cz
                 )));
             }
-            // The elastic rail's equilibrium (seed paper Sect. 4.2) balances
+            // The elastic rail's equilibrium (Pogorelov 2005, Sect. 4.2) balances
             // the Hertz force against the rail support: a damper along the
             // contact normal has no place in it (the rail's dampers cy, cz
             // act in series with the Hertz spring instead).
