@@ -1,6 +1,6 @@
 //! Wheelsets on the track with wheel–rail contact: physics oracles.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_runtime::NumericEquations;

@@ -2,7 +2,7 @@
 //! suspension, `models/vehicles/vehicle2.ron`) on track case 3: quick
 //! physics checks on the first half second, before the lateral sinusoid.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_models::{Model, Scenario};

@@ -1,7 +1,7 @@
 //! Trains: several vehicles on one track coupled by couplers
 //! (`railmbs_runtime::train`).
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_models::{Model, TrainScenario, load_model, load_scenario, parse_train};

@@ -6,7 +6,7 @@
 //! the damped oscillator's decrement (paper Table 1), force values computed
 //! by hand, and the local Jacobians against central differences.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::f64::consts::PI;

@@ -4,7 +4,7 @@
 //! surface gives the same forces and Jacobians as the equivalent point–plane
 //! contact; bad surfaces give clear errors.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::f64::consts::PI;

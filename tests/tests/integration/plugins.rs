@@ -2,7 +2,7 @@
 //! from another model, for another ABI version, or is not a plugin at all; and a
 //! simulation gives the same trajectory with either engine.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_runtime::integrate::ParkSettings;

@@ -1,7 +1,7 @@
 //! Integrated motion of the bundled mechanisms against analytic solutions and
 //! conservation laws (issue 2's physics tests).
 
-mod common;
+use crate::common;
 
 use common::*;
 use nalgebra::{Matrix3, Vector3};

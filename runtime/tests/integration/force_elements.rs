@@ -6,7 +6,7 @@
 //! (an independent computation), from closed-form solutions, or from runs with
 //! the finite-difference Jacobian, never from the analytic Jacobian under test.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::ops::ControlFlow;

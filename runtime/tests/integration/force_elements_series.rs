@@ -3,7 +3,7 @@
 //! the closed-form solution of the linear third-order system, the energy
 //! balance of the damper, and its Jacobian against central differences.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::ops::ControlFlow;

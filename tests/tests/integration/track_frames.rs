@@ -3,7 +3,7 @@
 //! constant velocity in SC0, with either engine; and the engines agree with
 //! inputs set.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_runtime::integrate::ParkSettings;

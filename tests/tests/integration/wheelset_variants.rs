@@ -1,7 +1,7 @@
 //! Wheelset variants: massless elastic rails (Pogorelov 2005, Sect. 4.2) and
 //! independently rotating wheels, against physics.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_models::{IntegratorSpec, Scenario};

@@ -4,7 +4,7 @@
 //! reproduced exactly inside the table (the three-point slope is exact for
 //! them), and the element's Jacobian against central differences.
 
-mod common;
+use crate::common;
 
 use common::*;
 use railmbs_runtime::ModelSystem;

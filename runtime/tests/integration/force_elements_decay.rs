@@ -6,7 +6,7 @@
 //! under a constant Coulomb force), which follows in closed form from the
 //! energy balance over the half cycle.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::ops::ControlFlow;

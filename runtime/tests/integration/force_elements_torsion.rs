@@ -4,7 +4,7 @@
 //! at φ(0) = φ0 + A is φ0 + A e^(−σt) (cos ω_d t + (σ/ω_d) sin ω_d t) with
 //! σ = d/(2J) and ω_d = √(c/J − σ²).
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::ops::ControlFlow;

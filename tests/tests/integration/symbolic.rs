@@ -2,7 +2,7 @@
 //! numeric-iterative engine on random states (relative 1e-12 on M, k, Q_g,
 //! kinematics, Jacobians, constraints), and the same trajectories.
 
-mod common;
+use crate::common;
 
 use common::*;
 use nalgebra::DMatrix;

@@ -2,7 +2,7 @@
 //! the direct method M = Σ Γ_jᵀ M_j Γ_j, finite differences of body positions
 //! and velocities, the potential energy, and a closed-form rheonomic case.
 
-mod common;
+use crate::common;
 
 use common::*;
 use nalgebra::{DMatrix, DVector};

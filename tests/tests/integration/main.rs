@@ -1,0 +1,13 @@
+//! The integration tests of `tests`, one module per topic, linked into one
+//! test binary.
+
+mod common;
+mod dynamics;
+mod equations;
+mod plugins;
+mod symbolic;
+mod track_frames;
+mod train;
+mod vehicle2;
+mod wheelset_variants;
+mod wheelsets;
