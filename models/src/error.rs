@@ -68,14 +68,17 @@ impl std::error::Error for ModelError {}
 pub struct ModelErrors(pub Vec<ModelError>);
 
 impl ModelErrors {
+    /// True if no problem was recorded.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
 
+    /// Number of problems.
     pub fn len(&self) -> usize {
         self.0.len()
     }
 
+    /// The problems, in the order they are reported.
     pub fn iter(&self) -> std::slice::Iter<'_, ModelError> {
         self.0.iter()
     }

@@ -4,13 +4,21 @@
 /// A function usable in expressions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Func {
+    /// `sin`: sine of an angle in radians.
     Sin,
+    /// `cos`: cosine of an angle in radians.
     Cos,
+    /// `tan`: tangent of an angle in radians.
     Tan,
+    /// `sqrt`: square root (NaN for a negative argument).
     Sqrt,
+    /// `abs`: absolute value.
     Abs,
+    /// `exp`: the exponential e^x.
     Exp,
+    /// `ln`: natural logarithm (NaN for a negative argument).
     Ln,
+    /// `atan`: arctangent of one argument, radians in [−π/2, π/2].
     Atan,
 }
 
@@ -21,17 +29,27 @@ pub enum Func {
 /// contact's height `z = f(x, y)`); only such element fields accept them.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {
+    /// A numeric literal (`pi` is parsed to one too).
     Num(f64),
+    /// The identifier (parameter) `Model::parameters[i]`.
     Param(usize),
+    /// Time `t`, s.
     Time,
+    /// The local variable [`VAR_NAMES`]`[i]` of the evaluating force element.
     Var(usize),
+    /// `-a`.
     Neg(Box<Expr>),
+    /// `a + b`.
     Add(Box<Expr>, Box<Expr>),
+    /// `a - b`.
     Sub(Box<Expr>, Box<Expr>),
+    /// `a * b`.
     Mul(Box<Expr>, Box<Expr>),
+    /// `a / b`.
     Div(Box<Expr>, Box<Expr>),
     /// `a ^ b`.
     Pow(Box<Expr>, Box<Expr>),
+    /// `f(a)`: a function applied to one argument.
     Call(Func, Box<Expr>),
 }
 

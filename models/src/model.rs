@@ -15,8 +15,11 @@ use std::path::PathBuf;
 /// Axis of an elementary transformation or a vector component.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Axis {
+    /// The x axis (component 0).
     X,
+    /// The y axis (component 1).
     Y,
+    /// The z axis (component 2).
     Z,
 }
 
@@ -35,7 +38,9 @@ impl Axis {
 /// axis of the current (moving) frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ElementaryKind {
+    /// `Tx`, `Ty`, `Tz`: translation along the axis (m).
     Translation(Axis),
+    /// `Rx`, `Ry`, `Rz`: rotation about the axis (rad, right-handed).
     Rotation(Axis),
 }
 
@@ -58,7 +63,10 @@ pub enum Motion {
 /// One elementary transformation `tx ty tz rx ry rz`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Elementary {
+    /// Translation or rotation, and along or about which axis.
     pub kind: ElementaryKind,
+    /// Its amount (m or rad): fixed, a coordinate, a function of time or a
+    /// runtime input.
     pub motion: Motion,
 }
 
@@ -108,18 +116,26 @@ pub struct Coordinate {
 /// rotations about x, then y, then z of the moving frame (rad).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
+    /// Origin in the body frame (SC0 for ground), m.
     pub origin: [Expr; 3],
+    /// Rotation angles about x, then y, then z of the moving frame, rad.
     pub rotation_xyz: [Expr; 3],
 }
 
 /// A relative-pose component that a cut joint constrains, measured in frame 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Component {
+    /// Translation along x of frame 1, m.
     Tx,
+    /// Translation along y of frame 1, m.
     Ty,
+    /// Translation along z of frame 1, m.
     Tz,
+    /// Small rotation about x of frame 1, rad.
     Rx,
+    /// Small rotation about y of frame 1, rad.
     Ry,
+    /// Small rotation about z of frame 1, rad.
     Rz,
 }
 
@@ -130,11 +146,19 @@ pub enum Component {
 /// small relative rotation angle).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CutJoint {
+    /// Long name (with subsystem prefix).
     pub name: String,
+    /// The first body (or ground).
     pub body1: BodyRef,
+    /// Frame 1, fixed to `body1` (`point1`, `rotation1`); the components are
+    /// measured in its axes.
     pub frame1: Frame,
+    /// The second body (or ground).
     pub body2: BodyRef,
+    /// Frame 2, fixed to `body2` (`point2`, `rotation2`).
     pub frame2: Frame,
+    /// The constrained components (`constrain`), in file order, each once
+    /// and at least one.
     pub constrained: Vec<Component>,
 }
 
@@ -165,12 +189,15 @@ pub enum Interpolation {
 pub struct ForceElement {
     /// Long name, used in output variable names.
     pub name: String,
+    /// The element type and its resolved fields.
     pub kind: ForceKind,
 }
 
 /// An identifier of the model: a runtime input of both engines.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameter {
+    /// Long name (with subsystem prefix, e.g. `Bogie1.WS2.m`), as used in
+    /// expressions and scenario overrides.
     pub name: String,
     /// Default: an expression over other parameters (never `t`).
     pub default: Expr,
@@ -181,6 +208,7 @@ pub struct Parameter {
 /// A named set of assignments applied at once ("loaded", a wedge type...).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Macro {
+    /// Long name (with subsystem prefix, e.g. `Bogie1.WS2.worn`).
     pub name: String,
     /// (parameter index, new value expression).
     pub assignments: Vec<(usize, Expr)>,
@@ -206,10 +234,14 @@ pub const TRACK_FRAME_COMPONENTS: [&str; 6] = ["x", "y", "z", "yaw", "pitch", "r
 /// A resolved, validated model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
+    /// The `name` of the top model file (included files' names are ignored).
     pub name: String,
     /// The file it was loaded from, when it came from a file.
     pub source: Option<PathBuf>,
+    /// The identifiers, indexed by [`Expr::Param`]: the file's own in file
+    /// order, then each subsystem's (recursively) in the order of `subsystems`.
     pub parameters: Vec<Parameter>,
+    /// Named sets of assignments, the file's own, then the subsystems'.
     pub macros: Vec<Macro>,
     /// m/s², expressions over parameters. Default (0, 0, −9.81).
     pub gravity: [Expr; 3],
@@ -217,7 +249,9 @@ pub struct Model {
     pub bodies: Vec<Body>,
     /// In order of appearance (body order, then elementary order).
     pub coordinates: Vec<Coordinate>,
+    /// Loop-closing constraints, the file's own, then the subsystems'.
     pub cut_joints: Vec<CutJoint>,
+    /// Force elements, the file's own, then the subsystems'.
     pub forces: Vec<ForceElement>,
     /// Track-following frames; each supplies six runtime inputs.
     pub track_frames: Vec<TrackFrame>,

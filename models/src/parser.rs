@@ -20,7 +20,13 @@ use std::fmt;
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParseErrorKind {
     /// Malformed text: what was expected and what was found instead.
-    Syntax { expected: String, found: String },
+    Syntax {
+        /// What the parser expected there, e.g. `a number`.
+        expected: String,
+        /// What it found instead: the character (or number text) in quotes, or
+        /// `the end of the expression`.
+        found: String,
+    },
     /// An identifier that is not a parameter of the model.
     UnknownIdentifier(String),
     /// `t` where the value must not depend on time.
@@ -34,6 +40,7 @@ pub struct ParseError {
     pub text: String,
     /// 1-based character column within `text`.
     pub column: usize,
+    /// What went wrong.
     pub kind: ParseErrorKind,
 }
 

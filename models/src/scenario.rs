@@ -9,14 +9,14 @@ pub enum JacobianKind {
     /// Central finite differences of the generalized forces (test oracle).
     #[default]
     FiniteDifference,
-    /// Assembled from the force elements' local analytic Jacobians (paper Sect. 6).
+    /// Assembled from the force elements' local analytic Jacobians (Pogorelov 2005, Sect. 6).
     Analytic,
 }
 
 /// Integrator settings.
 #[derive(Debug, Clone, PartialEq)]
 pub enum IntegratorSpec {
-    /// Park's implicit method with variable step (paper Sect. 6).
+    /// Park's implicit method with variable step (Pogorelov 2005, Sect. 6).
     Park {
         /// Relative tolerance of the local error estimate.
         rtol: f64,
@@ -26,6 +26,7 @@ pub enum IntegratorSpec {
         max_step: f64,
         /// First step, s (default: derived from tolerances and max_step).
         initial_step: Option<f64>,
+        /// Jacobian of the Newton iteration (default `FiniteDifference`).
         jacobian: JacobianKind,
     },
     /// Classical explicit fourth-order Runge–Kutta with fixed step (models
@@ -156,10 +157,14 @@ pub struct Scenario {
     /// model's parameters; a RON number is stored as its text). Resolved by
     /// `Model::parameter_values`, which names this scenario file in its errors.
     pub parameters: Vec<(String, String)>,
+    /// Initial-condition overrides of coordinates (`initial`), replacing the
+    /// model's `init` and `vel`; checked by [`Scenario::initial_state`].
     pub initial: Vec<InitialOverride>,
-    /// s.
+    /// Simulated time from t = 0, s.
     pub end_time: f64,
+    /// The integrator and its settings.
     pub integrator: IntegratorSpec,
+    /// What is written, and how often.
     pub output: OutputSpec,
     /// Output CSV, resolved relative to the scenario file; the command line's
     /// `-o` overrides it.
@@ -616,15 +621,21 @@ impl Scenario {
 /// rotation (angular stiffness and damping, default 0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainCoupler {
+    /// Coupler name (unique in the train), prefix of its output columns.
     pub name: String,
-    /// Vehicle index (in `TrainScenario::vehicles`) and body long name within
-    /// its model, from `"Coach1.body"`.
+    /// Vehicle index of body 1 (in `TrainScenario::vehicles`), from the
+    /// vehicle name in `body1: "Coach1.body"`.
     pub vehicle1: usize,
+    /// Body long name of body 1 within its vehicle's model (`body` in
+    /// `"Coach1.body"`), checked by [`TrainScenario::resolve_coupler`].
     pub body1: String,
     /// Attachment point in body 1's frame (from its centre of mass), m.
     pub point1: [f64; 3],
+    /// Vehicle index of body 2 (another vehicle than `vehicle1`).
     pub vehicle2: usize,
+    /// Body long name of body 2 within its vehicle's model.
     pub body2: String,
+    /// Attachment point in body 2's frame (from its centre of mass), m.
     pub point2: [f64; 3],
     /// Translational stiffness along x, y, z of body 1, N/m.
     pub stiffness: [f64; 3],
@@ -658,9 +669,15 @@ pub struct TrainVehicle {
     /// Arc offset of the vehicle's reference point from the train's, m
     /// (negative behind: 0, −26, −52 for three 26 m coaches).
     pub offset: f64,
+    /// Macros of the vehicle's model to apply, in order, before the parameter
+    /// overrides.
     pub macros: Vec<String>,
-    /// The train's `parameters` known to this model, then the vehicle's own.
+    /// The vehicle's own parameter overrides (name, value expression text);
+    /// [`TrainScenario::vehicle_scenario`] puts the train-wide ones its model
+    /// knows before them.
     pub parameters: Vec<(String, String)>,
+    /// Initial-condition overrides of the vehicle's coordinates (names
+    /// without the vehicle prefix).
     pub initial: Vec<InitialOverride>,
 }
 
@@ -670,17 +687,23 @@ pub struct TrainVehicle {
 pub struct TrainScenario {
     /// The train file.
     pub source: PathBuf,
+    /// The vehicles, at least one, with unique names.
     pub vehicles: Vec<TrainVehicle>,
+    /// Couplers, each between bodies of two different vehicles.
     pub couplers: Vec<TrainCoupler>,
     /// Train-wide parameter overrides (applied to every vehicle whose model
     /// has the parameter; each must be known to at least one model).
     pub parameters: Vec<(String, String)>,
+    /// Simulated time from t = 0, s.
     pub end_time: f64,
+    /// The integrator and its settings, for the whole train.
     pub integrator: IntegratorSpec,
     /// Names in `bodies` and `forces` are `<vehicle>.<long name>` or `"*"`;
     /// coordinates are written as `<vehicle>.<coordinate>`. Coupler forces
     /// are always written.
     pub output: OutputSpec,
+    /// Output CSV, resolved relative to the train file; the command line's
+    /// `-o` overrides it.
     pub output_file: Option<PathBuf>,
     /// The train's reference point starts at `start` (the first vehicle at
     /// offset 0 usually) and runs at `speed`.

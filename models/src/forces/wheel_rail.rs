@@ -69,9 +69,13 @@ pub enum RailKind {
     /// Massless rail heads on lateral and vertical spring–dampers (per rail):
     /// N/m, N s/m.
     Elastic {
+        /// Lateral stiffness, N/m (positive).
         ky: Expr,
+        /// Lateral damping, N s/m (default 0).
         cy: Expr,
+        /// Vertical stiffness, N/m (positive).
         kz: Expr,
+        /// Vertical damping, N s/m (default 0).
         cz: Expr,
     },
 }
@@ -80,9 +84,13 @@ pub enum RailKind {
 /// [−roll_max, roll_max] by droll (m, rad).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactTableSpec {
+    /// Largest lateral shift of the wheelset, m (default 0.025).
     pub y_max: f64,
+    /// Lateral step, m (default 1e-4).
     pub dy: f64,
+    /// Largest roll, rad (default 0.03; 0 allowed).
     pub roll_max: f64,
+    /// Roll step, rad (default 2e-3).
     pub droll: f64,
 }
 
