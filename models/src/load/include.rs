@@ -177,22 +177,6 @@ pub(super) enum Node {
     Sub(usize, usize),
 }
 
-/// Levenshtein distance (for suggestions in error messages).
-fn distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
 /// `"; close matches: \"a\", \"b\""` for the candidates close to `name`
 /// (small edit distance, or the same last part of a long name), or `""`.
 pub(super) fn close_matches<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> String {
@@ -202,7 +186,8 @@ pub(super) fn close_matches<'a>(name: &str, candidates: impl Iterator<Item = &'a
     let limit = if len <= 2 { 0 } else { (len / 4).clamp(1, 3) };
     let mut found: Vec<&str> = candidates
         .filter(|c| {
-            *c != name && (distance(c, name) <= limit || c.rsplit('.').next() == Some(last))
+            *c != name
+                && (strsim::levenshtein(c, name) <= limit || c.rsplit('.').next() == Some(last))
         })
         .collect();
     found.sort_unstable();
