@@ -137,15 +137,26 @@ pub struct EngineTimes {
 /// Everything `umsim bench` measures.
 #[derive(Debug, Clone)]
 pub struct BenchReport {
+    /// Name of the model (for a train file, the train's name and its number
+    /// of vehicles).
     pub model: String,
+    /// The model (or train) file given on the command line.
     pub model_file: PathBuf,
+    /// Number of degrees of freedom (for a train, summed over its vehicles).
     pub dof: usize,
+    /// Number of bodies (for a train, summed over its vehicles).
     pub bodies: usize,
+    /// Number of random states evaluated at (`--states`).
     pub states: usize,
+    /// The scenario file that was run, if any (a train file is its own
+    /// scenario).
     pub scenario: Option<PathBuf>,
     /// Why no scenario was run.
     pub scenario_note: Option<String>,
+    /// Measurements of the numeric-iterative engine.
     pub numeric: EngineTimes,
+    /// Measurements of the compiled symbolic plugin; what was not measured
+    /// is `None` and its `note` says why.
     pub symbolic: EngineTimes,
     /// Symbolic derivation, s.
     pub derive_s: Option<f64>,
@@ -320,8 +331,11 @@ impl Rng {
 /// A state (t, q, q̇) to evaluate at.
 #[derive(Debug, Clone)]
 pub struct State {
+    /// Time, s.
     pub t: f64,
+    /// Generalized coordinates q (m or rad), model order.
     pub q: Vec<f64>,
+    /// Generalized velocities q̇ (m/s or rad/s), model order.
     pub v: Vec<f64>,
 }
 

@@ -59,12 +59,19 @@ impl BodyKinematics {
 /// Which parts of an [`Evaluation`] to compute (others are left untouched).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Parts {
+    /// The mass matrix M ([`Evaluation::mass`]).
     pub mass: bool,
+    /// The bias terms k ([`Evaluation::bias`]): generalized inertia forces
+    /// at q̈ = 0 (see the module docs).
     pub bias: bool,
+    /// The generalized gravity forces Q_g ([`Evaluation::gravity`]).
     pub gravity: bool,
     /// Body kinematics (always cheap; computed whenever anything else is).
     pub kinematics: bool,
+    /// The stacked body Jacobians Γ_j ([`Evaluation::jacobians`]).
     pub jacobians: bool,
+    /// The cut-joint constraints g and G = ∂g/∂q
+    /// ([`Evaluation::constraints`], [`Evaluation::constraint_jacobian`]).
     pub constraints: bool,
 }
 

@@ -60,7 +60,9 @@ fn kinks(track: &Track) -> Vec<f64> {
 /// The running speed of a scenario: constant, or a profile of knots (t, v).
 #[derive(Debug, Clone, PartialEq)]
 pub enum RunningSpeed {
+    /// Constant speed: s(t) = s0 + v t (m, m/s).
     Constant(ConstantSpeed),
+    /// Speed linear between knots (t, v) (s, m/s), held constant outside.
     Profile(SpeedTable),
 }
 

@@ -69,11 +69,16 @@ pub enum ContactMode {
     /// Not in contact at the last accepted step.
     Free,
     /// Sticking to the anchor, given in the plane body's frame (m).
-    Stick { anchor: Vector3<f64> },
+    Stick {
+        /// Anchor point in the plane body's frame, m.
+        anchor: Vector3<f64>,
+    },
     /// Sliding; `dir` the unit sliding direction (SC0) at the last accepted
     /// step; `established` once the sliding speed has reached [`V_STICK`].
     Slide {
+        /// Unit sliding direction in SC0 (dimensionless).
         dir: Vector3<f64>,
+        /// Whether the sliding speed has reached [`V_STICK`].
         established: bool,
     },
 }
@@ -93,13 +98,20 @@ pub struct PointPlane {
     /// Plane point and unit normal in the plane body's frame.
     origin: Vector3<f64>,
     normal: Vector3<f64>,
-    /// N/m, N s/m (normal); N/m, N s/m (tangential anchor).
+    /// Normal stiffness, N/m.
     pub c: f64,
+    /// Normal damping, N s/m: the normal force is
+    /// max(0, c δ + d δ̇) with δ the penetration (m).
     pub d: f64,
+    /// Tangential stiffness of the sticking anchor, N/m.
     pub ct: f64,
+    /// Tangential damping of the sticking anchor, N s/m.
     pub dt: f64,
-    /// Static and sliding friction coefficients.
+    /// Static friction coefficient (dimensionless): the sticking anchor
+    /// holds while its force is at most μ_static times the normal force.
     pub mu_static: f64,
+    /// Sliding friction coefficient (dimensionless): the tangential force
+    /// while sliding is μ times the normal force.
     pub mu: f64,
     /// One per point.
     pub modes: Vec<ContactMode>,

@@ -24,7 +24,10 @@ pub struct Linear6 {
     preload_expr: [Expr; 6],
     /// N/m, N/rad, N m/m, N m/rad.
     pub stiffness: Matrix6<f64>,
+    /// Damping matrix D, multiplying δ̇: N s/m, N s/rad, N m s/m,
+    /// N m s/rad (same layout as `stiffness`).
     pub damping: Matrix6<f64>,
+    /// Preload W₀ (force N, then moment N m), in frame 1.
     pub preload: Vector6<f64>,
     /// Nonlinear characteristic f(δx) replacing the stiffness term C₀₀ δx
     /// of the x force (a coupler's draw gear and buffers).

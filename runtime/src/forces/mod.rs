@@ -41,7 +41,9 @@ use railmbs_models::{ForceKind, Model};
 /// Force (N) and moment about the centre of mass (N m) on one body, in SC0.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Wrench {
+    /// Force on the body, N, in SC0.
     pub force: Vector3<f64>,
+    /// Moment about the body's centre of mass, N m, in SC0.
     pub moment: Vector3<f64>,
 }
 
@@ -71,7 +73,9 @@ pub struct Assessment {
 pub struct ForceContext<'a> {
     /// s.
     pub t: f64,
+    /// Kinematics of every body, in model order (index = body index).
     pub bodies: &'a [BodyKinematics],
+    /// Parameter values, in `model.parameters` order.
     pub params: &'a [f64],
     /// First-order element states z of the whole system (see
     /// [`ForceElement::state_count`]); each element reads its own slice.

@@ -52,11 +52,21 @@ pub enum FrictionMode {
     /// No state yet (before the first accepted step): behaves as sliding.
     Initial,
     /// Sticking with the stored force f0 (N) at the stored length x0 (m).
-    Stick { f0: f64, x0: f64 },
+    Stick {
+        /// Force when sticking began, N.
+        f0: f64,
+        /// Length when sticking began, m.
+        x0: f64,
+    },
     /// Sliding; `dir` is the sign of ẋ when the mode was entered or last
     /// confirmed; `established` once the sliding speed has reached
     /// [`V_STICK`].
-    Slide { dir: f64, established: bool },
+    Slide {
+        /// Sign of ẋ (±1) when the mode was entered or last confirmed.
+        dir: f64,
+        /// Whether the sliding speed has reached [`V_STICK`].
+        established: bool,
+    },
 }
 
 /// Bipolar Coulomb friction: sticking F = f0 + c (x − x0) + d ẋ (f0, x0
@@ -273,7 +283,10 @@ pub struct LoadFriction {
     pub c1: f64,
     /// N/m.
     pub c2: f64,
+    /// Static friction coefficient μ0 of the block (dimensionless): the
+    /// sticking limit is μ0 c2 |x2|.
     pub mu_static: f64,
+    /// Sliding friction coefficient μ of the block (dimensionless).
     pub mu: f64,
     /// m.
     pub free_length: f64,

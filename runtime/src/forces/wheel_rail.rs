@@ -379,6 +379,10 @@ impl std::fmt::Debug for WheelRailContact {
 }
 
 impl WheelRailContact {
+    /// The element named `name` from the model's wheel–rail spec. Nothing
+    /// is evaluated or checked here: the constants come with
+    /// [`ForceElement::set_parameters`] and the profiles and contact table
+    /// with [`ForceElement::bind_track`], which report errors.
     pub fn new(name: String, spec: &WheelRail) -> Self {
         Self {
             name,
