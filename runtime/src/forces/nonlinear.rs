@@ -261,7 +261,7 @@ impl ForceElement for CoulombFriction {
 // Load-dependent friction
 // ---------------------------------------------------------------------------
 
-/// Load-dependent friction (paper Sect. 3.1, Fig. 3): spring c1 in series
+/// Load-dependent friction (Pogorelov 2005, Sect. 3.1, Fig. 3): spring c1 in series
 /// with a block of spring c2 in parallel with friction μ·|c2·x2| (x2 the
 /// block's deformation). With x = distance − x0 and the force
 /// F = c1 (x − x2):

@@ -901,7 +901,7 @@ impl WheelRailContact {
         (damper_power, elastic_energy): (f64, f64),
     ) -> Result<ContactState, SimError> {
         // Linear creep coefficients (Kalker), scaled by the saturation of the
-        // actual forces, for the approximate Jacobian (paper Sect. 6).
+        // actual forces, for the approximate Jacobian (Pogorelov 2005, Sect. 6).
         let (f11, f22) = KalkerCoefficients::saturated_slopes(
             patch.a,
             patch.b,

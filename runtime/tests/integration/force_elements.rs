@@ -1,5 +1,5 @@
 //! Force elements: local Jacobians against central differences of the forces,
-//! and Park's method with the analytic approximate Jacobian (paper Sect. 6)
+//! and Park's method with the analytic approximate Jacobian (Pogorelov 2005, Sect. 6)
 //! against finite differences.
 //!
 //! Expected values come from central differences of the forces themselves

@@ -3,7 +3,7 @@
 //! incline (sticking below μ0, sliding with g(sin α − μ cos α) above, energy
 //! lost = friction work), the stick–slip cycle of a block on a moving belt,
 //! a Coulomb element holding a load without drift,
-//! the damped oscillator's decrement (paper Table 1), force values computed
+//! the damped oscillator's decrement (Pogorelov 2005, Table 1), force values computed
 //! by hand, and the local Jacobians against central differences.
 
 use crate::common;

@@ -1,5 +1,5 @@
 //! Free vibration of a mass on the load-dependent friction element (seed
-//! paper Sect. 3.1, Fig. 3 element, Fig. 4 decaying vibration). The element's
+//! Pogorelov 2005, Sect. 3.1, Fig. 3 element, Fig. 4 decaying vibration). The element's
 //! force–deflection loop is rate-independent and homogeneous of degree one in
 //! the amplitude, so the free vibration decays geometrically: every half
 //! cycle multiplies the amplitude by the same factor (unlike the linear decay

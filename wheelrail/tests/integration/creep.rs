@@ -231,7 +231,7 @@ fn rel_total(a: &CreepForces, r: &CreepForces) -> f64 {
 
 /// FastSim_A against FASTSIM with many elements (same 20 strips, 4000 elements
 /// per strip: FASTSIM's own discretisation error is then < 0.1 %):
-/// - zero spin: FastSim_A is the exact strip solution (paper property 1):
+/// - zero spin: FastSim_A is the exact strip solution (Pogorelov 2005, Sect. 4.3, property 1):
 ///   agreement to 0.2 %, for every treatment of the sliding zone (their
 ///   corrections vanish with the spin);
 /// - tread-contact spin (|φ| ≤ 0.3 1/m, i.e. |φ|a ≤ 0.0018 for a = 6 mm; contact
