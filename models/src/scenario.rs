@@ -6,7 +6,9 @@ use std::path::PathBuf;
 /// Which Jacobian Park's Newton iteration uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum JacobianKind {
-    /// Central finite differences of the generalized forces (test oracle).
+    /// Forward finite differences of the generalized forces, one evaluation per
+    /// coordinate and velocity (a test oracle; the integrator also has central
+    /// differences, which scenarios do not select).
     #[default]
     FiniteDifference,
     /// Assembled from the force elements' local analytic Jacobians (Pogorelov 2005, Sect. 6).
