@@ -456,7 +456,7 @@ impl ModelSystem {
             if let Some(loads) = f.assessment_loads(&ctx) {
                 self.accepted_loads.push(LoadSample { key, t, loads });
             }
-            f.accept_step(&ctx);
+            f.accept_step(&ctx)?;
         }
         Ok(())
     }

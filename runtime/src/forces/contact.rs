@@ -458,7 +458,7 @@ impl ForceElement for PointPlane {
         }
     }
 
-    fn accept_step(&mut self, ctx: &ForceContext) {
+    fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         for k in 0..self.points.len() {
             let Some(e) = self.evaluate(ctx, k) else {
                 self.modes[k] = ContactMode::Free;
@@ -508,6 +508,7 @@ impl ForceElement for PointPlane {
                 }
             };
         }
+        Ok(())
     }
 
     /// Sums the points' contributions in the twist coordinates of the two

@@ -110,8 +110,11 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn output_names(&self) -> Vec<String>;
     /// Values of the outputs, appended to `out`, same order as the names.
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>);
-    /// Called once per accepted step (elements with state update here only).
-    fn accept_step(&mut self, _ctx: &ForceContext) {}
+    /// Called once per accepted step (elements with state update here only);
+    /// an error ends the run with its message (the rows written are kept).
+    fn accept_step(&mut self, _ctx: &ForceContext) -> Result<(), SimError> {
+        Ok(())
+    }
     /// Connects the element to the scenario's track (wheel–rail contact);
     /// elements that do not need the track ignore it.
     fn bind_track(&mut self, _binding: &TrackBinding) -> Result<(), SimError> {

@@ -203,7 +203,7 @@ impl ForceElement for CoulombFriction {
         out.extend([f, s.length, s.rate, sliding]);
     }
 
-    fn accept_step(&mut self, ctx: &ForceContext) {
+    fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         let s = self.pair.state(ctx);
         let (f, _, _, branch) = self.law(s.length, s.rate);
         self.mode = match (self.mode, branch) {
@@ -247,6 +247,7 @@ impl ForceElement for CoulombFriction {
                 }
             }
         };
+        Ok(())
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
@@ -416,7 +417,7 @@ impl ForceElement for LoadFriction {
         out.extend([f, x, x2, sliding]);
     }
 
-    fn accept_step(&mut self, ctx: &ForceContext) {
+    fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         let s = self.pair.state(ctx);
         let (_, _, x2, branch) = self.law(s.length - self.free_length, s.rate);
         self.mode = match (self.mode, branch) {
@@ -431,6 +432,7 @@ impl ForceElement for LoadFriction {
             _ => FrictionMode::Stick { f0: 0.0, x0: 0.0 },
         };
         self.x2 = x2;
+        Ok(())
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {

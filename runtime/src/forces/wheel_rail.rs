@@ -1191,8 +1191,8 @@ impl ForceElement for WheelRailContact {
         })
     }
 
-    fn accept_step(&mut self, ctx: &ForceContext) {
-        let Ok(state) = self.solve(ctx) else { return };
+    fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
+        let state = self.solve(ctx)?;
         // Elastic rails: this step's rail displacements become the start of
         // the next step's damper rate (never changed inside Newton
         // iterations or by rejected steps).
@@ -1212,6 +1212,7 @@ impl ForceElement for WheelRailContact {
                 }
             }
         }
+        Ok(())
     }
 
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError> {
