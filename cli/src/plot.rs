@@ -114,11 +114,6 @@ pub fn column_pattern(pattern: &str) -> globset::GlobMatcher {
         .compile_matcher()
 }
 
-/// Whether `name` matches `pattern` (see [`column_pattern`]).
-pub fn glob_match(pattern: &str, name: &str) -> bool {
-    column_pattern(pattern).is_match(name)
-}
-
 /// The fewest edits turning `piece` into some substring of `text`.
 fn substring_distance(piece: &str, text: &str) -> usize {
     let t: Vec<char> = text.chars().collect();
@@ -853,6 +848,10 @@ mod tests {
 
     fn h(names: &[&str]) -> Vec<String> {
         names.iter().map(|s| s.to_string()).collect()
+    }
+
+    fn glob_match(pattern: &str, name: &str) -> bool {
+        column_pattern(pattern).is_match(name)
     }
 
     #[test]
