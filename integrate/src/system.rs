@@ -85,7 +85,7 @@ pub trait MechanicalSystem {
     }
 
     /// Approximate analytic Jacobians of f: `dfdq` ≈ ∂f/∂q (≈ −C) and `dfdv` ≈
-    /// ∂f/∂q̇ (≈ −D), assembled from the force elements' local Jacobians (paper
+    /// ∂f/∂q̇ (≈ −D), assembled from the force elements' local Jacobians (Pogorelov 2005,
     /// Sect. 6). Returns `Ok(false)` when the system has none, and the integrator
     /// then uses finite differences of [`MechanicalSystem::dynamics`].
     fn force_jacobian(

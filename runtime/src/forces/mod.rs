@@ -154,7 +154,7 @@ pub trait ForceElement: std::fmt::Debug + Send {
     /// Residuals of the element's state equations (in force units, so that
     /// the rows scale like the equations of motion), `state_count` entries.
     fn state_residuals(&self, _ctx: &ForceContext, _out: &mut [f64]) {}
-    /// Adds the element's approximate contribution to ∂Q/∂q and ∂Q/∂q̇ (paper
+    /// Adds the element's approximate contribution to ∂Q/∂q and ∂Q/∂q̇ (Pogorelov 2005,
     /// Sect. 6, Eq. 31): its local stiffness and damping matrices mapped by the
     /// Jacobians of its attachment points, neglecting the derivatives of the
     /// body Jacobians Γ themselves. Uses the element's current state (mode,
