@@ -22,6 +22,12 @@
 //! solver to restart from a state of its choosing. [`Stepper::stats`] counts
 //! steps, rejections, Newton iterations and evaluations so far.
 //!
+//! A step ends with [`MechanicalSystem::accept_step`], where force elements
+//! with state (friction modes, stick anchors) move on. Output evaluated after
+//! that sees the next step's element states; [`Stepper::step_observed`]
+//! instead calls an observer with the end state of the step before accepting
+//! it, which is where a runner evaluates the output rows of the step.
+//!
 //! ```no_run
 //! # use railmbs_integrate::{MechanicalSystem, Park, ParkSettings, SimError, Stepper};
 //! # fn run(system: &mut impl MechanicalSystem, q0: &[f64], v0: &[f64]) -> Result<(), SimError> {
@@ -91,6 +97,21 @@ pub trait Stepper {
     /// [`SimError::Other`] when the stop time has been reached.
     fn step(&mut self) -> Result<StepView<'_>, SimError>;
 
+    /// As [`Stepper::step`], and calls `before_accept` with the system and
+    /// the state at the end of the step once the step has passed its tests
+    /// and before [`MechanicalSystem::accept_step`]: the system's element
+    /// states are still those the step was integrated with, so outputs
+    /// evaluated there (at the end state or at states interpolated within
+    /// the step) agree with the accelerations of the step. An error of
+    /// `before_accept` ends the step with that error (nothing accepted).
+    ///
+    /// # Errors
+    /// As [`Stepper::step`], and the errors of `before_accept`.
+    fn step_observed(
+        &mut self,
+        before_accept: BeforeAccept<'_, Self::System>,
+    ) -> Result<StepView<'_>, SimError>;
+
     /// Steps until `t` (s), reached exactly (sets the stop time), and returns
     /// the state there.
     ///
@@ -114,6 +135,10 @@ pub trait Stepper {
     /// steps; evaluations must not change what the next step sees).
     fn system_mut(&mut self) -> &mut Self::System;
 }
+
+/// The observer of [`Stepper::step_observed`]: called with the system and
+/// the end state of a step before the step is accepted.
+pub type BeforeAccept<'a, S> = &'a mut dyn FnMut(&mut S, StepView<'_>) -> Result<(), SimError>;
 
 /// One reported state: the end of an accepted step (or the initial state).
 #[derive(Debug, Clone, Copy)]

@@ -101,7 +101,7 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 
 use super::linalg::DenseLu;
 use super::{
-    IntegrationStats, StepView, Stepper, at_stop_time, check_end_time, check_finite,
+    BeforeAccept, IntegrationStats, StepView, Stepper, at_stop_time, check_end_time, check_finite,
     check_initial_state, check_stop_time,
 };
 use crate::system::{MechanicalSystem, SimError};
@@ -1181,6 +1181,36 @@ impl<S: MechanicalSystem> Stepper for Park<S> {
     /// smaller step (or a fresh Jacobian) until one is accepted.
     /// [`MechanicalSystem::accept_step`] is called once with its state.
     fn step(&mut self) -> Result<StepView<'_>, SimError> {
+        self.advance(None)
+    }
+
+    fn step_observed(
+        &mut self,
+        before_accept: BeforeAccept<'_, S>,
+    ) -> Result<StepView<'_>, SimError> {
+        self.advance(Some(before_accept))
+    }
+
+    fn stats(&self) -> &IntegrationStats {
+        &self.stats
+    }
+
+    fn system(&self) -> &S {
+        &self.system
+    }
+
+    fn system_mut(&mut self) -> &mut S {
+        &mut self.system
+    }
+}
+
+impl<S: MechanicalSystem> Park<S> {
+    /// One accepted step, calling `before_accept` (if any) with its end state
+    /// before [`MechanicalSystem::accept_step`] (see [`Stepper::step_observed`]).
+    fn advance(
+        &mut self,
+        mut before_accept: Option<BeforeAccept<'_, S>>,
+    ) -> Result<StepView<'_>, SimError> {
         let s = &self.settings;
         let (t, t_end, t0) = (self.t, self.t_stop, self.t0);
         if t >= t_end {
@@ -1367,6 +1397,19 @@ impl<S: MechanicalSystem> Stepper for Park<S> {
                 w.ha[0].copy_from(&w.a);
                 w.lambda.copy_from(&w.lam);
             }
+            if let Some(observe) = before_accept.as_mut() {
+                observe(
+                    system,
+                    StepView {
+                        t: t_new,
+                        h: hs,
+                        q: w.hq[0].as_slice(),
+                        v: w.hv[0].as_slice(),
+                        accel: w.ha[0].as_slice(),
+                        lambda: w.lambda.as_slice(),
+                    },
+                )?;
+            }
             st.steps += 1;
             system.accept_step(t_new, w.hq[0].as_slice(), w.hv[0].as_slice())?;
             if iterations >= 6 || theta_max > 0.2 {
@@ -1391,18 +1434,6 @@ impl<S: MechanicalSystem> Stepper for Park<S> {
             self.record_state();
             return Ok(self.state());
         }
-    }
-
-    fn stats(&self) -> &IntegrationStats {
-        &self.stats
-    }
-
-    fn system(&self) -> &S {
-        &self.system
-    }
-
-    fn system_mut(&mut self) -> &mut S {
-        &mut self.system
     }
 }
 

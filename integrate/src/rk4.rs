@@ -14,8 +14,8 @@ use nalgebra::{DMatrix, DVector};
 use super::linalg::{cholesky_in_place, cholesky_solve};
 
 use super::{
-    IntegrationStats, StepView, Stepper, at_stop_time, check_finite, check_initial_state,
-    check_stop_time,
+    BeforeAccept, IntegrationStats, StepView, Stepper, at_stop_time, check_finite,
+    check_initial_state, check_stop_time,
 };
 use crate::system::{MechanicalSystem, SimError};
 
@@ -193,6 +193,36 @@ impl<S: MechanicalSystem> Stepper for Rk4<S> {
     }
 
     fn step(&mut self) -> Result<StepView<'_>, SimError> {
+        self.advance(None)
+    }
+
+    fn step_observed(
+        &mut self,
+        before_accept: BeforeAccept<'_, S>,
+    ) -> Result<StepView<'_>, SimError> {
+        self.advance(Some(before_accept))
+    }
+
+    fn stats(&self) -> &IntegrationStats {
+        &self.stats
+    }
+
+    fn system(&self) -> &S {
+        &self.system
+    }
+
+    fn system_mut(&mut self) -> &mut S {
+        &mut self.system
+    }
+}
+
+impl<S: MechanicalSystem> Rk4<S> {
+    /// One step, calling `before_accept` (if any) with its end state before
+    /// [`MechanicalSystem::accept_step`] (see [`Stepper::step_observed`]).
+    fn advance(
+        &mut self,
+        before_accept: Option<BeforeAccept<'_, S>>,
+    ) -> Result<StepView<'_>, SimError> {
         let (t, h, t_end) = (self.t, self.h, self.t_stop);
         if t >= t_end {
             return Err(at_stop_time(t));
@@ -234,35 +264,51 @@ impl<S: MechanicalSystem> Stepper for Rk4<S> {
         check_finite(t_new, "coordinate q", self.q.as_slice())?;
         check_finite(t_new, "velocity v", self.v.as_slice())?;
         self.stats.steps += 1;
+        // The acceleration at the new state is the next step's first stage.
+        // An observer sees it before the step is accepted; it is evaluated
+        // again after acceptance only where accepting can change it.
+        let observed = match before_accept {
+            Some(observe) => {
+                acceleration(
+                    &mut self.system,
+                    t_new,
+                    &self.q,
+                    &self.v,
+                    &mut self.mass,
+                    &mut self.a1,
+                    &mut self.stats,
+                )?;
+                let view = StepView {
+                    t: t_new,
+                    h: hs,
+                    q: self.q.as_slice(),
+                    v: self.v.as_slice(),
+                    accel: self.a1.as_slice(),
+                    lambda: &[],
+                };
+                observe(&mut self.system, view)?;
+                true
+            }
+            None => false,
+        };
         self.system
             .accept_step(t_new, self.q.as_slice(), self.v.as_slice())?;
-        // The acceleration at the new state is the next step's first stage.
-        acceleration(
-            &mut self.system,
-            t_new,
-            &self.q,
-            &self.v,
-            &mut self.mass,
-            &mut self.a1,
-            &mut self.stats,
-        )?;
+        if !observed || self.system.remembers_accepted_steps() {
+            acceleration(
+                &mut self.system,
+                t_new,
+                &self.q,
+                &self.v,
+                &mut self.mass,
+                &mut self.a1,
+                &mut self.stats,
+            )?;
+        }
         self.stats.t = t_new;
         self.stats.q.copy_from(&self.q);
         self.stats.v.copy_from(&self.v);
         self.stats.accel.copy_from(&self.a1);
         Ok(self.state())
-    }
-
-    fn stats(&self) -> &IntegrationStats {
-        &self.stats
-    }
-
-    fn system(&self) -> &S {
-        &self.system
-    }
-
-    fn system_mut(&mut self) -> &mut S {
-        &mut self.system
     }
 }
 

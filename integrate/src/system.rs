@@ -105,6 +105,15 @@ pub trait MechanicalSystem {
     fn accept_step(&mut self, _t: f64, _q: &[f64], _v: &[f64]) -> Result<(), SimError> {
         Ok(())
     }
+
+    /// Whether [`MechanicalSystem::accept_step`] can change what
+    /// [`MechanicalSystem::dynamics`] returns for the same (t, q, q̇) (force
+    /// elements with state). `true` unless the system knows better; a solver
+    /// that evaluates the state at the end of a step both before and after
+    /// accepting it skips the second evaluation when `false`.
+    fn remembers_accepted_steps(&self) -> bool {
+        true
+    }
 }
 
 /// A mutable reference integrates as the system itself (a solver can then
@@ -156,5 +165,9 @@ impl<S: MechanicalSystem + ?Sized> MechanicalSystem for &mut S {
 
     fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
         (**self).accept_step(t, q, v)
+    }
+
+    fn remembers_accepted_steps(&self) -> bool {
+        (**self).remembers_accepted_steps()
     }
 }

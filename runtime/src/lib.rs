@@ -7,6 +7,17 @@
 //! output columns to a sink ([`run`]). The integrators (Park's implicit
 //! method, RK4) are the crate `railmbs-integrate`, re-exported as
 //! [`integrate`].
+//!
+//! # How the types stack
+//!
+//! | type | implements | what it is |
+//! |---|---|---|
+//! | [`NumericEquations`], [`PluginEquations`] | [`Equations`] | an engine: M, k, Q_g, body kinematics and Jacobians at (t, q, q̇) for given parameters (numeric-iterative, or a compiled symbolic plugin) |
+//! | [`DrivenEquations`] | [`Equations`] | an engine whose runtime inputs (track-following frames) come from an [`InputProvider`] such as [`TrackInputs`] |
+//! | [`ModelSystem`] | [`MechanicalSystem`] | one model: an engine plus its force elements and parameters, M q̈ = Q_g − k + Σ Γᵀ F |
+//! | [`train::TrainSystem`] | [`MechanicalSystem`] | several `ModelSystem`s (the vehicles) and the couplers between them |
+//! | [`integrate::Park`], [`integrate::Rk4`] | [`Stepper`] | a solver stepping a `MechanicalSystem` |
+//! | [`run`] | | the runner: steps a solver, writes rows to an [`run::OutputSink`] |
 
 pub mod equations;
 pub mod forces;

@@ -431,6 +431,10 @@ impl MechanicalSystem for ModelSystem {
     fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
         self.accept_forces(t, q, v)
     }
+
+    fn remembers_accepted_steps(&self) -> bool {
+        self.forces.iter().any(|f| f.remembers_accepted_steps())
+    }
 }
 
 impl ModelSystem {

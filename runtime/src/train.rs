@@ -457,6 +457,10 @@ impl MechanicalSystem for TrainSystem {
         }
         Ok(())
     }
+
+    fn remembers_accepted_steps(&self) -> bool {
+        self.vehicles.iter().any(|s| s.remembers_accepted_steps())
+    }
 }
 
 impl RunSystem for TrainSystem {

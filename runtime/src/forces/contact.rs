@@ -458,6 +458,10 @@ impl ForceElement for PointPlane {
         }
     }
 
+    fn remembers_accepted_steps(&self) -> bool {
+        true
+    }
+
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         for k in 0..self.points.len() {
             let Some(e) = self.evaluate(ctx, k) else {

@@ -112,8 +112,16 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>);
     /// Called once per accepted step (elements with state update here only);
     /// an error ends the run with its message (the rows written are kept).
+    /// An element that changes its forces here must also return `true` from
+    /// [`ForceElement::remembers_accepted_steps`].
     fn accept_step(&mut self, _ctx: &ForceContext) -> Result<(), SimError> {
         Ok(())
+    }
+    /// Whether [`ForceElement::accept_step`] can change the element's forces
+    /// for the same state (stick anchors, friction modes, elastic rails):
+    /// solvers then evaluate the end of a step again after accepting it.
+    fn remembers_accepted_steps(&self) -> bool {
+        false
     }
     /// Connects the element to the scenario's track (wheel–rail contact);
     /// elements that do not need the track ignore it.

@@ -203,6 +203,10 @@ impl ForceElement for CoulombFriction {
         out.extend([f, s.length, s.rate, sliding]);
     }
 
+    fn remembers_accepted_steps(&self) -> bool {
+        true
+    }
+
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         let s = self.pair.state(ctx);
         let (f, _, _, branch) = self.law(s.length, s.rate);
@@ -415,6 +419,10 @@ impl ForceElement for LoadFriction {
         let f = if s.direction.is_some() { f } else { 0.0 };
         let sliding = matches!(self.mode, FrictionMode::Slide { .. }) as u8 as f64;
         out.extend([f, x, x2, sliding]);
+    }
+
+    fn remembers_accepted_steps(&self) -> bool {
+        true
     }
 
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {

@@ -108,9 +108,6 @@ fn smoothstep(x: f64) -> f64 {
     x * x * (3.0 - 2.0 * x)
 }
 
-/// Accepted steps whose elastic-rail displacements are kept.
-const RAIL_HISTORY: usize = 4;
-
 /// Largest tan δ used for the contact's lead ahead of the axle plane (75°).
 const MAX_LEAD_TAN: f64 = 3.73;
 
@@ -359,11 +356,12 @@ pub struct WheelRailContact {
     /// The kinematics are the wheelset's and each wheel's body's (the same
     /// body thrice for a solid wheelset).
     last: std::sync::Mutex<Option<(f64, [BodyKinematics; 3], WheelsetState)>>,
-    /// Elastic rails: the rails' displacements (left, right; (d_y, d_z) each,
-    /// m) at the last accepted steps with their times, newest last. Only
-    /// [`ForceElement::accept_step`] changes it. Several steps are kept: the
-    /// output rows between two accepted steps are evaluated one step later.
-    rail_history: [Option<RailRecord>; RAIL_HISTORY],
+    /// Elastic rails: the rails at the last accepted step. Only
+    /// [`ForceElement::accept_step`] changes it; every evaluation until the
+    /// next accepted step (Newton iterations, Jacobians, the output rows of
+    /// the step, which the runner evaluates before accepting it) starts from
+    /// it.
+    rail_accepted: Option<RailRecord>,
     /// A valid Hertz shape for contacts without load (elastic rails).
     placeholder_shape: Option<HertzShape>,
 }
@@ -390,7 +388,7 @@ impl WheelRailContact {
             c: Constants::default(),
             bound: None,
             last: std::sync::Mutex::new(None),
-            rail_history: [None; RAIL_HISTORY],
+            rail_accepted: None,
             placeholder_shape: HertzShape::with_modulus(1.0, 1.0, 1.0).ok(),
         }
     }
@@ -664,21 +662,15 @@ impl WheelRailContact {
 
     /// Where the backward-Euler rate of the elastic rails starts from at time
     /// `t` (s): (h, d_prev, creep) with d_prev the rails' displacements (left,
-    /// right; (d_y, d_z) each, m) at the latest accepted step before `t`, h
-    /// the time since it (s) and the creep forces there (where the outer
-    /// iterations start). Without an accepted step before `t` (the start of a
-    /// run) the rails are in static equilibrium: h = ∞.
+    /// right; (d_y, d_z) each, m) at the last accepted step, h the time since
+    /// it (s) and the creep forces there (where the outer iterations start).
+    /// At the accepted time itself or before any accepted step (the start of
+    /// a run) the rails are in static equilibrium: h = ∞.
     fn rail_reference(&self, t: f64) -> (f64, [[f64; 2]; 2], [CreepStart; 2]) {
-        match self
-            .rail_history
-            .iter()
-            .rev()
-            .flatten()
-            .find(|(tr, _, _)| *tr < t)
-        {
-            Some((tr, d, creep)) => (t - tr, *d, *creep),
-            None => {
-                let (_, d, creep) = self.rail_history[RAIL_HISTORY - 1].unwrap_or_default();
+        match self.rail_accepted {
+            Some((tr, d, creep)) if tr < t => (t - tr, d, creep),
+            accepted => {
+                let (_, d, creep) = accepted.unwrap_or_default();
                 (f64::INFINITY, d, creep)
             }
         }
@@ -1047,7 +1039,7 @@ impl ForceElement for WheelRailContact {
         }
         self.c = c;
         *self.last.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
-        self.rail_history = [None; RAIL_HISTORY];
+        self.rail_accepted = None;
         Ok(())
     }
 
@@ -1191,26 +1183,18 @@ impl ForceElement for WheelRailContact {
         })
     }
 
+    fn remembers_accepted_steps(&self) -> bool {
+        // Elastic rails start their damper rate from the accepted step.
+        self.c.rail.is_some()
+    }
+
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
         let state = self.solve(ctx)?;
         // Elastic rails: this step's rail displacements become the start of
         // the next step's damper rate (never changed inside Newton
         // iterations or by rejected steps).
         if self.c.rail.is_some() {
-            let entry = Some((ctx.t, state.rail_d, state.rail_creep));
-            let h = &mut self.rail_history;
-            match h[RAIL_HISTORY - 1] {
-                // A new run from an earlier time: forget the old one.
-                Some((t_last, _, _)) if ctx.t < t_last => {
-                    *h = [None; RAIL_HISTORY];
-                    h[RAIL_HISTORY - 1] = entry;
-                }
-                Some((t_last, _, _)) if ctx.t == t_last => h[RAIL_HISTORY - 1] = entry,
-                _ => {
-                    h.rotate_left(1);
-                    h[RAIL_HISTORY - 1] = entry;
-                }
-            }
+            self.rail_accepted = Some((ctx.t, state.rail_d, state.rail_creep));
         }
         Ok(())
     }

@@ -388,16 +388,21 @@ impl Runner<'_> {
         );
         let s = solver.state();
         schedule.observe(s.t, s.q, s.v, s.accel, &mut rows.pending, progress);
-        while solver.t() < t1 {
-            solver.step()?;
+        rows.flush(&mut **solver.system_mut(), columns, sink);
+        while solver.t() < t1 && rows.failure.is_none() {
+            // The rows within the step are evaluated before the step is
+            // accepted: with the element states (friction modes, elastic
+            // rails) that the step was integrated with.
+            solver.step_observed(&mut |system, s| {
+                schedule.observe(s.t, s.q, s.v, s.accel, &mut rows.pending, progress);
+                rows.flush(&mut **system, columns, sink);
+                Ok(())
+            })?;
             let system = &mut **solver.system_mut();
             pass_loads(system, &mut rows.loads, &mut rows.reducer, sink);
-            rows.flush(system, columns, sink);
-            if rows.failure.is_some() {
-                return Ok(None);
-            }
-            let s = solver.state();
-            schedule.observe(s.t, s.q, s.v, s.accel, &mut rows.pending, progress);
+        }
+        if rows.failure.is_some() {
+            return Ok(None);
         }
         Ok(Some(solver.stats().clone()))
     }

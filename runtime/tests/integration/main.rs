@@ -9,4 +9,5 @@ mod force_elements_series;
 mod force_elements_surface;
 mod force_elements_tabulated;
 mod force_elements_torsion;
+mod output_rows;
 mod outputs_accelerometer;
