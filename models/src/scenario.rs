@@ -367,6 +367,27 @@ struct Common {
     parameters: Vec<(String, String)>,
 }
 
+/// Most output rows a run may write: end_time / interval. A run past it is
+/// refused when the file is read (10⁸ rows of a vehicle's few hundred
+/// columns are tens of gigabytes of CSV); a longer study splits its runs.
+pub const MAX_OUTPUT_ROWS: f64 = 1e8;
+
+/// Most integration steps a run may need at the least: end_time / step for
+/// RK4, end_time / max_step for Park's method. At a microsecond per step
+/// (a one-body model) 10⁹ steps are a quarter of an hour; a vehicle takes
+/// a hundred times longer.
+pub const MAX_STEPS: f64 = 1e9;
+
+/// `x` as written for a reader: plain between 10⁻⁴ and 10⁶, else with an
+/// exponent (Rust's `{}` writes 1e-308 with 308 digits).
+fn readable(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Validates the parts common to `Scenario` and `Train` files (`check`
 /// records an error at the first `key:` of the file when `ok` is false).
 fn common(
@@ -384,12 +405,36 @@ fn common(
         "end_time",
         format!("end_time must be positive and finite, got {} s", end_time),
     );
+    // Steps a run needs at the least with steps of at most `h`.
+    let too_many_steps = |h: f64| positive(end_time) && positive(h) && end_time / h > MAX_STEPS;
     let integrator = match raw_integrator {
         RawIntegrator::Rk4 { step } => {
             check(
                 positive(step),
                 "step",
                 format!("integrator step must be positive and finite, got {step} s"),
+            );
+            check(
+                !(positive(end_time) && step > end_time),
+                "step",
+                format!(
+                    "RK4 step {} s is longer than the run (end_time {} s); \
+                     a fixed-step explicit method needs many steps per period of the \
+                     fastest motion",
+                    readable(step),
+                    readable(end_time)
+                ),
+            );
+            check(
+                !too_many_steps(step),
+                "step",
+                format!(
+                    "RK4 step {} s over end_time {} s would take {:.3e} steps \
+                     (at most {MAX_STEPS:e})",
+                    readable(step),
+                    readable(end_time),
+                    end_time / step
+                ),
             );
             IntegratorSpec::Rk4 { step }
         }
@@ -415,6 +460,17 @@ fn common(
                 "max_step",
                 format!("integrator max_step must be positive and finite, got {max_step} s"),
             );
+            check(
+                !too_many_steps(max_step),
+                "max_step",
+                format!(
+                    "max_step {} s over end_time {} s would take at least \
+                     {:.3e} steps (at most {MAX_STEPS:e})",
+                    readable(max_step),
+                    readable(end_time),
+                    end_time / max_step
+                ),
+            );
             if let Some(h) = initial_step {
                 check(
                     positive(h),
@@ -437,6 +493,17 @@ fn common(
         format!(
             "output interval must be positive and finite, got {} s",
             raw_output.interval
+        ),
+    );
+    let rows = end_time / raw_output.interval;
+    check(
+        !(positive(end_time) && positive(raw_output.interval) && rows > MAX_OUTPUT_ROWS),
+        "interval",
+        format!(
+            "end_time {} s with output interval {} s would write {rows:.3e} rows \
+             (at most {MAX_OUTPUT_ROWS:e}): choose a longer interval",
+            readable(end_time),
+            readable(raw_output.interval)
         ),
     );
     let track = raw_track.map(|t| {

@@ -209,6 +209,58 @@ fn validation_errors_name_the_scenario_file() {
     assert_names(&errs, &p, "Euler", 2);
 }
 
+/// Runs that could not finish (or would fill the disk) are refused when the
+/// file is read, at the field that makes them so.
+#[test]
+fn runs_beyond_the_limits_are_refused_up_front() {
+    let s = Scratch::new("limits");
+    let (p, errs) = errors_of(
+        &s,
+        "Scenario(model: \"m.ron\", end_time: 1e20,\n integrator: Park(rtol: 1e-6, atol: 1e-8, max_step: 1e-3),\n output: (interval: 0.01))",
+    );
+    assert_names(&errs, &p, "would write 1.000e22 rows", 3);
+    assert_names(&errs, &p, "would take at least 1.000e23 steps", 2);
+    let (p, errs) = errors_of(
+        &s,
+        "Scenario(model: \"m.ron\", end_time: 1,\n integrator: Rk4(step: 1e-308),\n output: (interval: 1e-300))",
+    );
+    assert_names(
+        &errs,
+        &p,
+        "RK4 step 1e-308 s over end_time 1 s would take 1.000e308 steps",
+        2,
+    );
+    assert_names(&errs, &p, "would write 1.000e300 rows", 3);
+    let (p, errs) = errors_of(
+        &s,
+        "Scenario(model: \"m.ron\", end_time: 10,\n integrator: Park(rtol: 1e-6, atol: 1e-8, max_step: 1e-9),\n output: (interval: 0.01))",
+    );
+    assert_eq!(errs.len(), 1, "{errs}");
+    assert_names(&errs, &p, "max_step 1e-9 s over end_time 10 s", 2);
+    let (p, errs) = errors_of(
+        &s,
+        "Scenario(model: \"m.ron\", end_time: 0.05,\n integrator: Rk4(step: 0.1),\n output: (interval: 0.01))",
+    );
+    assert_eq!(errs.len(), 1, "{errs}");
+    assert_names(
+        &errs,
+        &p,
+        "RK4 step 0.1 s is longer than the run (end_time 0.05 s)",
+        2,
+    );
+    // At the limits themselves a run is accepted.
+    let path = s.scenario(
+        "ok.ron",
+        "Scenario(model: \"m.ron\", end_time: 1, integrator: Rk4(step: 1e-9), output: (interval: 1e-8))",
+    );
+    let e = load_scenario(&path).err();
+    assert!(
+        e.as_ref()
+            .is_none_or(|e| !e.to_string().contains("at most")),
+        "{e:?}"
+    );
+}
+
 #[test]
 fn unknown_macro_parameter_or_coordinate_in_scenario() {
     let s = Scratch::new("names");

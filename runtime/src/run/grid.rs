@@ -106,6 +106,11 @@ impl OutputSchedule {
         }
     }
 
+    /// Time of the next row to be written, s.
+    pub(crate) fn next_row_time(&self) -> f64 {
+        (self.next_row as f64 * self.interval).min(self.t_end)
+    }
+
     /// Queues the output rows in (t_prev, t] after an accepted step ending at
     /// (t, q, q̇, q̈); the end time is always the last row.
     pub(crate) fn observe(
@@ -124,7 +129,10 @@ impl OutputSchedule {
             if is_last {
                 to = t_end;
             }
-            let reached = to <= t + 1e-12 * t_end.max(1.0);
+            // A row within rounding of the step's end is written there; the
+            // tolerance never reaches a row interval (a huge end time would
+            // otherwise let every row count as reached).
+            let reached = to <= t + (1e-12 * t_end.max(1.0)).min(1e-6 * self.interval);
             if !reached || (is_last && t < t_end * (1.0 - 1e-12)) {
                 break;
             }

@@ -195,6 +195,22 @@ fn pass_loads<S: RunSystem>(
     sink.accepted_loads(buffer, &name);
 }
 
+/// The error of a run that took [`MAX_STEPS_PER_ROW`] steps without
+/// reaching the output row at `next_row` (s); `t` (s) and `h` (s) are the
+/// last step's end and length.
+fn no_progress(t: f64, h: f64, next_row: f64) -> SimError {
+    SimError::Diverged {
+        t,
+        reason: format!(
+            "no progress: {MAX_STEPS_PER_ROW} steps without reaching the next output row \
+             at t = {next_row} s (the last step was {h:e} s); either the tolerances ask for \
+             more than double precision allows (rtol ≥ 1e-9 and atol ≥ 1e-9 are safe \
+             floors) or the model is much stiffer here than elsewhere (a contact or \
+             a friction element chattering)"
+        ),
+    }
+}
+
 /// A solver of the scenario's integrator for `system` at (t0, q0, v0).
 fn solver<'s, S: MechanicalSystem>(
     system: &'s mut S,
@@ -226,8 +242,17 @@ fn solver<'s, S: MechanicalSystem>(
     })
 }
 
+/// Accepted steps without reaching an output row after which a run stops as
+/// making no progress (as CVODE's `mxstep`): the step size has collapsed far
+/// below the output interval, usually because the tolerances ask for more
+/// than double precision allows or the model is far stiffer than expected.
+/// A million steps is seconds to minutes of CPU with nothing written.
+pub const MAX_STEPS_PER_ROW: usize = 1_000_000;
+
 /// Rows interpolated but not yet written, and what was written.
 struct Rows {
+    /// Accepted steps since the last output row.
+    steps_since_row: usize,
     pending: PendingRows,
     values: Vec<f64>,
     scratch: Vec<f64>,
@@ -305,6 +330,7 @@ impl Runner<'_> {
         sink.begin(columns.header())?;
         let mut schedule = OutputSchedule::new(self.t_end, self.interval, q0.len());
         let mut rows = Rows {
+            steps_since_row: 0,
             pending: PendingRows::new(),
             values: Vec::new(),
             scratch: Vec::new(),
@@ -329,6 +355,7 @@ impl Runner<'_> {
                 &mut schedule,
                 &mut rows,
                 progress,
+                summary,
             );
             let st = match segment {
                 Ok(Some(st)) => st,
@@ -362,7 +389,8 @@ impl Runner<'_> {
     }
 
     /// One segment from `t0` (state `q`, `v`) to `t1`; `None` when the sink
-    /// failed.
+    /// failed. After an error of a step the counts of the segment up to it
+    /// are added to `summary`.
     #[allow(clippy::too_many_arguments)]
     fn segment<S: RunSystem>(
         &self,
@@ -373,6 +401,7 @@ impl Runner<'_> {
         schedule: &mut OutputSchedule,
         rows: &mut Rows,
         progress: &mut impl FnMut(f64),
+        summary: &mut RunSummary,
     ) -> Result<Option<IntegrationStats>, SimError> {
         if rows.failure.is_some() {
             return Ok(None);
@@ -393,11 +422,23 @@ impl Runner<'_> {
             // The rows within the step are evaluated before the step is
             // accepted: with the element states (friction modes, elastic
             // rails) that the step was integrated with.
-            solver.step_observed(&mut |system, s| {
+            let step = solver.step_observed(&mut |system, s| {
                 schedule.observe(s.t, s.q, s.v, s.accel, &mut rows.pending, progress);
+                if rows.pending.is_empty() {
+                    rows.steps_since_row += 1;
+                    if rows.steps_since_row >= MAX_STEPS_PER_ROW {
+                        return Err(no_progress(s.t, s.h, schedule.next_row_time()));
+                    }
+                } else {
+                    rows.steps_since_row = 0;
+                }
                 rows.flush(&mut **system, columns, sink);
                 Ok(())
-            })?;
+            });
+            if let Err(e) = step {
+                summary.add_segment(solver.stats());
+                return Err(e);
+            }
             let system = &mut **solver.system_mut();
             pass_loads(system, &mut rows.loads, &mut rows.reducer, sink);
         }

@@ -72,3 +72,62 @@ fn every_row_satisfies_newtons_law_across_friction_mode_changes() {
         );
     }
 }
+
+/// A torsional oscillator: J = 2 kg m², c = 200 N m/rad, d = 0.8 N m s/rad,
+/// released at rest 0.2 rad from φ0 = 0.1 rad.
+const DISC: &str = r#"
+Model(
+    name: "torsion",
+    parameters: { "J": 2, "c": 200, "d": 0.8, "phi0": 0.1 },
+    gravity: (0, 0, 0),
+    bodies: [
+        Body(name: "disc", mass: 5, inertia: (ixx: 1, iyy: 1, izz: "J"),
+             joint: Revolute(parent: "ground", axis: Z, coord: "phi", init: 0.3)),
+    ],
+    forces: [
+        TorsionSpring(name: "t", body1: "ground", body2: "disc", axis: (0, 0, 2),
+                      c: "c", d: "d", phi0: "phi0"),
+    ],
+)
+"#;
+
+/// A run whose steps collapse stops with a message instead of running for
+/// hours: tolerances below what double precision resolves (atol 1e-11 rad on
+/// a 0.3 rad coordinate) make Park's steps shrink to about 1e-9 s, 1e-6 of
+/// the output interval (51 million steps for 0.05 s without the limit). The
+/// rows before are kept.
+#[test]
+fn a_run_without_progress_stops_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("disc.ron"), DISC).unwrap();
+    let text = r#"Scenario(model: "disc.ron", end_time: 0.05,
+        integrator: Park(rtol: 1e-9, atol: 1e-11, max_step: 1e-3, jacobian: Analytic),
+        output: (interval: 1e-3))"#;
+    let path = dir.path().join("run.ron");
+    std::fs::write(&path, text).unwrap();
+    let scenario = railmbs_models::parse_scenario(text, &path).unwrap();
+    let model = railmbs_models::load_model(&scenario.model).unwrap();
+    let mut table = Table::new();
+    let summary = run_scenario_into(
+        &scenario,
+        &model,
+        Box::new(NumericEquations::new(&model)),
+        &mut table,
+        |_| {},
+    )
+    .unwrap();
+    let err = summary.error.expect("the run should stop").to_string();
+    assert!(err.contains("no progress"), "{err}");
+    assert!(err.contains("next output row at t = "), "{err}");
+    // The step that reaches the limit is refused, not accepted.
+    assert_eq!(
+        summary.steps + 1,
+        railmbs_runtime::run::MAX_STEPS_PER_ROW,
+        "{err}"
+    );
+    assert!(
+        table.rows() >= 1 && summary.t_end < 0.05,
+        "{} rows",
+        table.rows()
+    );
+}
