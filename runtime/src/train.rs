@@ -636,7 +636,21 @@ pub fn run_train(
     progress: impl FnMut(f64),
 ) -> Result<RunSummary, RunError> {
     match output {
-        Some(path) => run_train_into(train, models, engines, &mut CsvFile::new(path), progress),
+        Some(path) => {
+            let csv = CsvFile::new(path);
+            let mut inputs = vec![
+                ("train file", train.source.as_path()),
+                ("track file", train.track.file.as_path()),
+            ];
+            inputs.extend(
+                train
+                    .vehicles
+                    .iter()
+                    .map(|v| ("model file", v.model.as_path())),
+            );
+            csv.refuse_inputs(inputs)?;
+            run_train_into(train, models, engines, &mut { csv }, progress)
+        }
         None => run_train_into(train, models, engines, &mut Discard, progress),
     }
 }

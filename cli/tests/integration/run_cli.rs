@@ -218,3 +218,31 @@ fn symbolic_engine_runs_or_says_why_not() {
         assert!(err.contains("symbolic"), "unclear error: {err}");
     }
 }
+
+/// `-o` naming one of the run's inputs is refused before anything is written.
+#[test]
+fn output_over_an_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = root().join("models");
+    let model = std::fs::read_to_string(models.join("mechanisms/chain3.ron")).unwrap();
+    std::fs::write(dir.path().join("chain3.ron"), &model).unwrap();
+    let scenario = "Scenario(model: \"chain3.ron\", end_time: 0.1, integrator: Rk4(step: 1e-3), output: (interval: 0.01))";
+    let run = dir.path().join("run.ron");
+    std::fs::write(&run, scenario).unwrap();
+    for (target, what) in [("run.ron", "scenario file"), ("chain3.ron", "model file")] {
+        let path = dir.path().join(target);
+        let before = std::fs::read_to_string(&path).unwrap();
+        let o = umsim(&["run", run.to_str().unwrap(), "-o", path.to_str().unwrap()]);
+        let stderr = text(&o.stderr);
+        assert!(!o.status.success(), "{stderr}");
+        assert!(
+            stderr.contains(&format!("the output file is the run's {what}")),
+            "{stderr}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            before,
+            "{target} changed"
+        );
+    }
+}

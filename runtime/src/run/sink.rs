@@ -79,6 +79,31 @@ impl CsvFile {
         &self.path
     }
 
+    /// Fails when the output file is one of `inputs` (the scenario, model
+    /// or track file a run reads): `-o scenario.ron` must not replace the
+    /// scenario by its results.
+    ///
+    /// # Errors
+    /// [`RunError::Setup`] naming the file and what it is.
+    pub fn refuse_inputs<'p>(
+        &self,
+        inputs: impl IntoIterator<Item = (&'p str, &'p Path)>,
+    ) -> Result<(), RunError> {
+        for (what, input) in inputs {
+            // Both must exist to be the same file; a new output is none.
+            if same_file::is_same_file(&self.path, input).unwrap_or(false) {
+                return Err(RunError::Setup {
+                    file: self.path.clone(),
+                    message: format!(
+                        "the output file is the run's {what} ({}); choose another output file",
+                        input.display()
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     fn io(&self, source: std::io::Error) -> RunError {
         RunError::Io {
             path: self.path.clone(),
