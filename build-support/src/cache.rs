@@ -66,6 +66,57 @@ fn platform_cache_dir() -> Result<PathBuf, BuildError> {
         })
 }
 
+/// The file beside a cached library that records its size and BLAKE3 digest.
+pub(crate) fn digest_path(library: &Path) -> PathBuf {
+    let mut name = library.as_os_str().to_owned();
+    name.push(".blake3");
+    PathBuf::from(name)
+}
+
+/// `"<size in bytes> <BLAKE3 hex>\n"` of the file at `path`.
+fn digest_line(path: &Path) -> Result<String, BuildError> {
+    let bytes = std::fs::read(path).map_err(|e| BuildError::io(path, e))?;
+    Ok(format!(
+        "{} {}\n",
+        bytes.len(),
+        blake3::hash(&bytes).to_hex()
+    ))
+}
+
+/// Records the size and digest of the freshly built `built` (not yet in
+/// place) for the cache entry `dest`. Written before the library is renamed
+/// into place, so that a complete library never lacks its record.
+pub(crate) fn record_digest(built: &Path, dest: &Path) -> Result<(), BuildError> {
+    let line = digest_line(built)?;
+    write_atomic(&digest_path(dest), line.as_bytes())
+}
+
+/// Checks the cached library `library` against its recorded size and digest;
+/// `Err` says what is wrong (no record, another size, another digest, unreadable).
+pub(crate) fn verify_digest(library: &Path) -> Result<(), String> {
+    let record_path = digest_path(library);
+    let recorded = std::fs::read_to_string(&record_path).map_err(|e| {
+        format!(
+            "no size and digest recorded ({}: {e})",
+            record_path.display()
+        )
+    })?;
+    let actual = digest_line(library).map_err(|e| e.to_string())?;
+    if recorded == actual {
+        return Ok(());
+    }
+    let size = |line: &str| line.split(' ').next().unwrap_or("").to_owned();
+    Err(if size(&recorded) != size(&actual) {
+        format!(
+            "its size is {} bytes, {} were recorded when it was built (a truncated file?)",
+            size(&actual),
+            size(&recorded)
+        )
+    } else {
+        "its content differs from the digest recorded when it was built".to_owned()
+    })
+}
+
 pub(crate) fn create_dir_all(dir: &Path) -> Result<(), BuildError> {
     std::fs::create_dir_all(dir).map_err(|e| BuildError::io(dir, e))
 }

@@ -42,6 +42,11 @@
 //! redundant compile, which a lock would only trade for waiting. A process killed while
 //! compiling leaves a `.tmp-build-*` directory behind that may be deleted at any time.
 //!
+//! Beside each library, `<library>.blake3` records its size and BLAKE3 digest (written
+//! before the library is renamed into place). A cache hit reads the library and checks
+//! both (about 1 ms per MB); a truncated, changed or unrecorded entry is rebuilt and
+//! [`BuildOutput::rebuilt_damaged`] says what was wrong with it.
+//!
 //! When rustc rejects the source, the source is kept as `<cache>/failed/<hash>.rs` and rustc's
 //! stderr as `<cache>/failed/<hash>.stderr`; the error ([`BuildError::CompileFailed`]) names
 //! both and quotes the stderr, whose file paths point at the kept source.
@@ -222,6 +227,9 @@ pub struct BuildOutput {
     pub compile_time: Option<Duration>,
     /// The rustc used (for the key; also on a cache hit).
     pub rustc: Rustc,
+    /// Set when the cache held a damaged entry for this key (truncated, changed, or
+    /// without its recorded digest), which was rebuilt: what was wrong with it.
+    pub rebuilt_damaged: Option<String>,
 }
 
 /// The cache key of `source` built with `flags` by the rustc whose `rustc -vV` is
@@ -271,14 +279,24 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
         std::env::consts::DLL_SUFFIX
     );
     let dest = cache.join(&lib_name);
+    // A cached library is used only when it is the file that was built: loading a
+    // truncated shared library crashes the process (SIGBUS), so a damaged entry is
+    // rebuilt instead, and the caller told.
+    let mut rebuilt_damaged = None;
     if dest.is_file() {
-        return Ok(BuildOutput {
-            path: dest,
-            hash,
-            cache_hit: true,
-            compile_time: None,
-            rustc,
-        });
+        match cache::verify_digest(&dest) {
+            Ok(()) => {
+                return Ok(BuildOutput {
+                    path: dest,
+                    hash,
+                    cache_hit: true,
+                    compile_time: None,
+                    rustc,
+                    rebuilt_damaged: None,
+                });
+            }
+            Err(reason) => rebuilt_damaged = Some(format!("{}: {reason}", dest.display())),
+        }
     }
 
     cache::create_dir_all(&cache)?;
@@ -340,6 +358,7 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
             ),
         ));
     }
+    cache::record_digest(&out_path, &dest)?;
     if let Err(e) = std::fs::rename(&out_path, &dest) {
         // Lost a race against a concurrent build of the same key (e.g. Windows refuses to
         // replace a loaded DLL): the file in place is equivalent.
@@ -353,6 +372,7 @@ pub fn build_plugin(source: &str, options: &BuildOptions) -> Result<BuildOutput,
         cache_hit: false,
         compile_time: Some(compile_time),
         rustc,
+        rebuilt_damaged,
     })
 }
 

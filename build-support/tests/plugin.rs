@@ -79,6 +79,51 @@ fn compile_load_call_and_cache() {
     );
 }
 
+/// A damaged cache entry (truncated, as by a full disk or a killed copy; changed; or
+/// without its recorded digest) is rebuilt and reported, never handed out: loading a
+/// truncated shared library crashes the process with SIGBUS.
+#[test]
+fn damaged_cache_entries_are_rebuilt() {
+    let cache = tempfile::tempdir().unwrap();
+    let first = build_plugin(ADD_SRC, &options(cache.path())).unwrap();
+    let intact = std::fs::read(&first.path).unwrap();
+    let record = {
+        let mut p = first.path.clone().into_os_string();
+        p.push(".blake3");
+        std::path::PathBuf::from(p)
+    };
+    assert!(record.is_file());
+    let damages: [(&str, &dyn Fn()); 3] = [
+        ("truncated", &|| {
+            std::fs::write(&first.path, &intact[..1000]).unwrap()
+        }),
+        ("its content differs", &|| {
+            let mut changed = intact.clone();
+            let k = changed.len() / 2;
+            changed[k] ^= 0xff;
+            std::fs::write(&first.path, changed).unwrap();
+        }),
+        ("no size and digest recorded", &|| {
+            std::fs::remove_file(&record).unwrap()
+        }),
+    ];
+    for (what, damage) in damages {
+        damage();
+        let again = build_plugin(ADD_SRC, &options(cache.path())).unwrap();
+        assert!(!again.cache_hit, "{what}: a damaged entry is no hit");
+        let reason = again.rebuilt_damaged.expect("the damage is reported");
+        assert!(reason.contains(what), "{what}: {reason}");
+        assert_eq!(
+            std::fs::read(&again.path).unwrap(),
+            intact,
+            "{what}: rebuilt as built"
+        );
+        let hit = build_plugin(ADD_SRC, &options(cache.path())).unwrap();
+        assert!(hit.cache_hit && hit.rebuilt_damaged.is_none(), "{what}");
+    }
+    assert_eq!(call_add(&first.path, 1.5, 2.25), 3.75);
+}
+
 #[test]
 fn syntax_error_keeps_the_source() {
     let cache = tempfile::tempdir().unwrap();

@@ -22,7 +22,11 @@ pub fn build_symbolic(
 ) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
     let mut opts = GenerateOptions::new();
     opts.portable = portable;
-    Ok(railmbs_codegen::build_plugin(model, &opts, None)?)
+    let built = railmbs_codegen::build_plugin(model, &opts, None)?;
+    if let Some(damage) = &built.rebuilt_damaged {
+        eprintln!("umsim: warning: rebuilt a damaged plugin cache entry: {damage}");
+    }
+    Ok(built)
 }
 
 /// Builds the engine for `model`. The symbolic engine loads `plugin` (checked

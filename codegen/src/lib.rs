@@ -173,6 +173,9 @@ pub struct BuiltPlugin {
     pub compile_time: Option<Duration>,
     /// Whether the library came from the cache.
     pub cache_hit: bool,
+    /// What was wrong with a damaged cache entry that was rebuilt (see
+    /// `railmbs_build_support::BuildOutput::rebuilt_damaged`).
+    pub rebuilt_damaged: Option<String>,
 }
 
 /// Generates and compiles the plugin of `model` through the cache
@@ -195,6 +198,7 @@ pub fn build_plugin(
         path: out.path,
         compile_time: out.compile_time,
         cache_hit: out.cache_hit,
+        rebuilt_damaged: out.rebuilt_damaged,
         generated,
     })
 }
