@@ -134,8 +134,9 @@ impl std::fmt::Debug for WheelRailContact {
 impl WheelRailContact {
     /// The element named `name` from the model's wheel–rail spec. Nothing
     /// is evaluated or checked here: the constants come with
-    /// [`ForceElement::set_parameters`] and the profiles and contact table
-    /// with [`ForceElement::bind_track`], which report errors.
+    /// [`ForceElement::set_parameters`] and the contact table (from the
+    /// profiles the model holds, read when it was loaded) with
+    /// [`ForceElement::bind_track`], which report errors.
     pub fn new(name: String, spec: &WheelRail) -> Self {
         Self {
             name,

@@ -1,6 +1,7 @@
 //! What the element needs before it runs: its constants, evaluated and
 //! checked from the parameters, and its binding to the scenario's track
-//! ([`TrackBinding`]): the wheel and rail profiles placed on the track, the
+//! ([`TrackBinding`]): the wheel and rail profiles (read when the model was
+//! loaded) smoothed and placed on the track, the
 //! contact table built from them (or reused from another wheelset of the run
 //! with the same profiles and dimensions) and the creep law.
 
@@ -8,15 +9,14 @@ use super::{WheelRailContact, nadal_limit};
 use crate::forces::eval_scalar;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
-use railmbs_models::RailKind;
+use railmbs_models::{ProfileFile, RailKind};
 use railmbs_track::Track;
 use railmbs_wheelrail::creep::{CreepLaw, CreepLawSpec};
 use railmbs_wheelrail::elastic_rail::RailSupport;
 use railmbs_wheelrail::geometry::{self, ContactTable, SearchSettings, TableSettings};
 use railmbs_wheelrail::hertz::effective_modulus;
-use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
+use railmbs_wheelrail::profile::{Profile, ProfileSettings};
 use std::collections::HashMap;
-use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 /// The scenario's track, as the wheel–rail elements see it.
@@ -102,14 +102,17 @@ impl WheelRailContact {
         })
     }
 
-    /// Reads the profiles and builds (or reuses) the contact table.
+    /// Places the profiles (read and validated when the model was loaded) on
+    /// the track, the rails inclined by the track's rail inclination unless
+    /// their files are drawn inclined, and builds (or reuses) the contact
+    /// table.
     pub(super) fn prepare(&self, binding: &TrackBinding) -> Result<Arc<PreparedContact>, SimError> {
         let track = &binding.track;
         let t = &self.spec.table;
         let key = format!(
             "{:?}|{:?}|{}|{}|{}|{}|{}|{}|{}|{}|{}|{}",
-            self.spec.wheel_profiles,
-            self.spec.rail_profiles,
+            self.spec.wheel_profiles.each_ref().map(|f| &f.path),
+            self.spec.rail_profiles.each_ref().map(|f| &f.path),
             self.spec.rail_profiles_inclined,
             self.c.radius,
             self.c.flange_back_distance,
@@ -128,13 +131,15 @@ impl WheelRailContact {
         if let Some(p) = tables.get(&key) {
             return Ok(p.clone());
         }
-        let read = |path: &PathBuf, kind: ProfileKind, inclination: f64| {
+        // The profiles were read and validated when the model was loaded;
+        // here they are smoothed, the rails inclined as the track says.
+        let read = |file: &ProfileFile, inclination: f64| {
             let settings = ProfileSettings {
                 rail_inclination: inclination,
                 ..ProfileSettings::default()
             };
-            Profile::read(path, kind, &settings)
-                .map_err(|e| self.err(format!("{}: {e}", path.display())))
+            Profile::from_points(&file.points, &settings)
+                .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
         };
         let inclination = if self.spec.rail_profiles_inclined {
             0.0
@@ -142,8 +147,8 @@ impl WheelRailContact {
             track.rail_inclination().atan()
         };
         let wheelset = geometry::Wheelset::new(
-            read(&self.spec.wheel_profiles[0], ProfileKind::Wheel, 0.0)?,
-            read(&self.spec.wheel_profiles[1], ProfileKind::Wheel, 0.0)?,
+            read(&self.spec.wheel_profiles[0], 0.0)?,
+            read(&self.spec.wheel_profiles[1], 0.0)?,
             self.c.radius,
             self.c.flange_back_distance,
         );
@@ -152,8 +157,8 @@ impl WheelRailContact {
             ..wheelset
         };
         let rails = geometry::Track::new(
-            read(&self.spec.rail_profiles[0], ProfileKind::Rail, inclination)?,
-            read(&self.spec.rail_profiles[1], ProfileKind::Rail, inclination)?,
+            read(&self.spec.rail_profiles[0], inclination)?,
+            read(&self.spec.rail_profiles[1], inclination)?,
             track.nominal_gauge(),
         );
         let table = ContactTable::new(
