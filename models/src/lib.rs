@@ -237,6 +237,11 @@
 //! - **Paths** (subsystem files, `WheelRail` profiles) are relative to the file
 //!   they are written in; the resolved model holds canonical (absolute)
 //!   profile paths. [`Model::source`] is the top file.
+//! - **Profiles** are read, parsed and validated when the model loads (a
+//!   missing or malformed file is a load error at the profile's field, naming
+//!   the file and its line); the model holds their points ([`ProfileFile`]),
+//!   and only the track's rail inclination is applied later, when a run
+//!   places them on the scenario's track.
 //!
 //! `models/mechanisms/subsystems/vehicle.ron` is a complete example (a car body,
 //! two bogies with two wheelsets each, and an absorber re-attached to the car

@@ -163,7 +163,7 @@ pub enum ProfileError {
 }
 
 /// Points of a profile in the library convention (metres), before smoothing.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ProfilePoints {
     /// Wheel or rail.
     pub kind: ProfileKind,

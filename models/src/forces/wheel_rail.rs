@@ -7,8 +7,10 @@ use crate::load::{Cx, Lookup, Where};
 use crate::model::BodyRef;
 use crate::raw::Value;
 use railmbs_wheelrail::creep::CreepLawSpec;
+use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfilePoints, ProfileSettings, read_points};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Wheel–rail contact of a wheelset on the scenario's track (Pogorelov 2005,
 /// Sect. 4): left and right wheel against their rails, contact geometry
@@ -22,12 +24,12 @@ pub struct WheelRail {
     /// The wheelset body.
     pub wheelset: usize,
     /// Wheel profiles (left, right; the right one mirrored when placed),
-    /// absolute paths.
-    pub wheel_profiles: [PathBuf; 2],
-    /// Rail profiles (left, right), absolute paths. The track's rail
-    /// inclination is applied when they are read, unless
-    /// `rail_profiles_inclined`.
-    pub rail_profiles: [PathBuf; 2],
+    /// read when the model is loaded.
+    pub wheel_profiles: [ProfileFile; 2],
+    /// Rail profiles (left, right), read when the model is loaded. The
+    /// track's rail inclination is applied when they are placed on the
+    /// scenario's track, unless `rail_profiles_inclined`.
+    pub rail_profiles: [ProfileFile; 2],
     /// The rail profile files are already drawn inclined (as the Manchester
     /// benchmark's UIC60 files are): the track's rail inclination is not
     /// applied again.
@@ -59,6 +61,59 @@ pub struct WheelRail {
     /// still follows the `wheelset` (axle) body's pose. `None`: a solid
     /// wheelset, both wheels on the `wheelset` body.
     pub wheels: Option<[usize; 2]>,
+}
+
+/// A wheel or rail profile file of a wheel–rail element, read, parsed and
+/// validated when the model is loaded: its points, and their smoothing with
+/// the default settings, are known to be valid. Elements naming the same file
+/// share the points (a file included several times is loaded once).
+#[derive(Clone, PartialEq)]
+pub struct ProfileFile {
+    /// The file, canonical (absolute): the resolved model does not depend on
+    /// the working directory, nor on which file included the element.
+    pub path: PathBuf,
+    /// Its points as read (library convention, m; see
+    /// [`railmbs_wheelrail::profile`]), before smoothing and before a rail
+    /// inclination is applied.
+    pub points: Arc<ProfilePoints>,
+}
+
+impl ProfileFile {
+    /// Reads and validates the `kind` profile at `path` (canonical): the
+    /// points, and their smoothing with the default settings (the wheels'
+    /// profile as the contact uses it; a rail's before its inclination).
+    pub fn read(path: PathBuf, kind: ProfileKind) -> Result<Self, String> {
+        let points = read_points(&path, kind).map_err(|e| e.to_string())?;
+        Profile::from_points(&points, &ProfileSettings::default()).map_err(|e| e.to_string())?;
+        Ok(ProfileFile {
+            path,
+            points: Arc::new(points),
+        })
+    }
+
+    /// A file that could not be read: no points (stands in for it while the
+    /// other problems of the model are collected; never in a loaded model).
+    fn missing(path: PathBuf, kind: ProfileKind) -> Self {
+        let points = ProfilePoints {
+            kind,
+            name: path.display().to_string(),
+            points: Vec::new(),
+        };
+        ProfileFile {
+            path,
+            points: Arc::new(points),
+        }
+    }
+}
+
+/// The path alone: the model's structural text
+/// ([`crate::Model::canonical_structure`]) names profiles by file, as the
+/// compiled plugin does not depend on their content (the wheel–rail forces
+/// are evaluated by the runtime).
+impl std::fmt::Debug for ProfileFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.path.fmt(f)
+    }
 }
 
 /// The rails of a wheel–rail element.
@@ -264,8 +319,9 @@ struct WheelRailRaw<'r> {
 }
 
 /// Resolves a wheel–rail element: the wheelset body, profile files (paths
-/// relative to the model file, which must exist; stored canonical), material and friction
-/// values (checked with the defaults), the creep law, rails and table grid.
+/// relative to the model file; read and validated here, each error at its
+/// field), material and friction values (checked with the defaults), the
+/// creep law, rails and table grid.
 fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box<WheelRail> {
     let wheelset = match cx.body_ref(w, "wheelset", raw.wheelset, lookup) {
         BodyRef::Body(k) => k,
@@ -282,11 +338,17 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
         }
     };
     let base = cx.file.parent().unwrap_or(Path::new("."));
-    let mut paths: Vec<PathBuf> = Vec::with_capacity(4);
+    let mut files: Vec<ProfileFile> = Vec::with_capacity(4);
     for (k, (key, text)) in raw.profiles.iter().enumerate() {
+        let kind = if k < 2 {
+            ProfileKind::Wheel
+        } else {
+            ProfileKind::Rail
+        };
         // A missing right-hand profile is the left one (mirrored when placed).
-        let Some(text) = text.or(raw.profiles[k - k % 2].1) else {
-            paths.push(PathBuf::new());
+        let Some(text) = text else {
+            let left = files[k - 1].clone();
+            files.push(left);
             continue;
         };
         let path = base.join(text);
@@ -297,10 +359,17 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
                 Some(text),
                 format!("profile file not found: {}", path.display()),
             );
+            files.push(ProfileFile::missing(path, kind));
+            continue;
         }
-        // Absolute, so that the resolved model does not depend on the
-        // working directory (nor on which file included this one).
-        paths.push(std::fs::canonicalize(&path).unwrap_or(path));
+        let path = std::fs::canonicalize(&path).unwrap_or(path);
+        files.push(match ProfileFile::read(path.clone(), kind) {
+            Ok(file) => file,
+            Err(e) => {
+                cx.err(w, Some(key), Some(text), format!("{kind} profile {e}"));
+                ProfileFile::missing(path, kind)
+            }
+        });
     }
     let e: Vec<Expr> = raw
         .values
@@ -373,8 +442,8 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
     let mut next = || e.next().expect("seven values");
     Box::new(WheelRail {
         wheelset,
-        wheel_profiles: [paths[0].clone(), paths[1].clone()],
-        rail_profiles: [paths[2].clone(), paths[3].clone()],
+        wheel_profiles: [files[0].clone(), files[1].clone()],
+        rail_profiles: [files[2].clone(), files[3].clone()],
         rail_profiles_inclined: raw.rail_profile_inclined,
         radius: next(),
         flange_back_distance: next(),

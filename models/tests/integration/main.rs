@@ -11,3 +11,4 @@ mod parameters;
 mod scenario;
 mod subsystems;
 mod validation;
+mod wheel_rail;

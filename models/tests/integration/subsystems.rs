@@ -2,6 +2,7 @@
 //! includer's parameters, track offsets, connection points, re-attachment,
 //! equality with a hand-written flat model, and located errors.
 
+use crate::common::{S1002_PRW, UIC60_BAN};
 use railmbs_models::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -479,8 +480,8 @@ const WHEELSET: &str = r#"Model(
 #[test]
 fn wheel_rail_profiles_are_relative_to_the_included_file() {
     let files = Files::new(&[
-        ("profiles/wheel.prw", "0 0\n1 1\n"),
-        ("profiles/rail.ban", "0 0\n1 1\n"),
+        ("profiles/wheel.prw", S1002_PRW),
+        ("profiles/rail.ban", UIC60_BAN),
         ("wheelsets/ws.ron", WHEELSET),
         (
             "vehicles/car.ron",
@@ -509,11 +510,11 @@ fn wheel_rail_profiles_are_relative_to_the_included_file() {
             m.body_index(&format!("WS{}.axle", k + 1)).unwrap()
         );
         let canonical = |f: &str| std::fs::canonicalize(files.path(f)).unwrap();
-        assert_eq!(w.wheel_profiles[0], canonical("profiles/wheel.prw"));
-        assert_eq!(w.wheel_profiles[1], canonical("profiles/wheel.prw"));
-        assert_eq!(w.rail_profiles[0], canonical("profiles/rail.ban"));
-        assert_eq!(w.rail_profiles[1], canonical("profiles/rail.ban"));
-        assert!(w.wheel_profiles[0].is_absolute());
+        assert_eq!(w.wheel_profiles[0].path, canonical("profiles/wheel.prw"));
+        assert_eq!(w.wheel_profiles[1].path, canonical("profiles/wheel.prw"));
+        assert_eq!(w.rail_profiles[0].path, canonical("profiles/rail.ban"));
+        assert_eq!(w.rail_profiles[1].path, canonical("profiles/rail.ban"));
+        assert!(w.wheel_profiles[0].path.is_absolute());
         let p = m.default_parameter_values();
         assert_eq!(w.radius.eval(&p, 0.0), 0.46);
     }
@@ -1046,8 +1047,8 @@ fn values_made_non_finite_by_an_override_are_errors() {
         1,
     );
     let files = Files::new(&[
-        ("profiles/wheel.prw", "0 0\n1 1\n"),
-        ("profiles/rail.ban", "0 0\n1 1\n"),
+        ("profiles/wheel.prw", S1002_PRW),
+        ("profiles/rail.ban", UIC60_BAN),
         ("wheelsets/ws.ron", &ws),
         ("wheelsets/bogie.ron", &bogie.replace("ws.ron", "./ws.ron")),
     ]);
@@ -1065,8 +1066,8 @@ fn values_made_non_finite_by_an_override_are_errors() {
 
     // Range checks of force elements, with the instance's parameters.
     let files = Files::new(&[
-        ("profiles/wheel.prw", "0 0\n1 1\n"),
-        ("profiles/rail.ban", "0 0\n1 1\n"),
+        ("profiles/wheel.prw", S1002_PRW),
+        ("profiles/rail.ban", UIC60_BAN),
         ("wheelsets/ws.ron", WHEELSET),
         ("wheelsets/bogie.ron", &bogie.replace("ws.ron", "./ws.ron")),
     ]);

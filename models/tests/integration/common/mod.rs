@@ -6,6 +6,13 @@ use std::path::Path;
 
 pub const FILE: &str = "models/mechanisms/x.ron";
 
+/// The bundled S1002 wheel profile (SIMPACK `.prw`), for tests that write
+/// their own profile files (profiles are read when a model loads).
+pub const S1002_PRW: &str = include_str!("../../../profiles/MBench_S1002_v3.prw");
+
+/// The bundled UIC60 rail profile (MiniProf `.ban`).
+pub const UIC60_BAN: &str = include_str!("../../../profiles/MBench_UIC60_v3.ban");
+
 /// A model using every construct of the language.
 pub const FULL: &str = r#"// A model using every construct.
 Model(

@@ -1,0 +1,264 @@
+//! What the element needs before it runs: its constants, evaluated and
+//! checked from the parameters, and its binding to the scenario's track
+//! ([`TrackBinding`]): the wheel and rail profiles (read when the model was
+//! loaded) smoothed and placed on the track, the
+//! contact table built from them (or reused from another wheelset of the run
+//! with the same profiles and dimensions) and the creep law.
+
+use super::{WheelRailContact, nadal_limit};
+use crate::forces::eval_scalar;
+use crate::system::SimError;
+use crate::track_inputs::RunningSpeed;
+use railmbs_models::{ProfileFile, RailKind};
+use railmbs_track::Track;
+use railmbs_wheelrail::creep::{CreepLaw, CreepLawSpec};
+use railmbs_wheelrail::elastic_rail::RailSupport;
+use railmbs_wheelrail::geometry::{self, ContactTable, SearchSettings, TableSettings};
+use railmbs_wheelrail::hertz::effective_modulus;
+use railmbs_wheelrail::profile::{Profile, ProfileSettings};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+/// The scenario's track, as the wheel–rail elements see it.
+pub struct TrackBinding {
+    /// The track.
+    pub track: Arc<Track>,
+    /// The running speed law s(t) of the reference point.
+    pub speed: RunningSpeed,
+    /// Arc offset of each body's track-following frame (its own, or its
+    /// nearest ancestor's), m; `None` for bodies not on a track frame.
+    pub body_offsets: Vec<Option<f64>>,
+    /// Contact tables already built in this run, shared between wheelsets
+    /// with the same profiles and dimensions.
+    pub tables: Mutex<HashMap<String, Arc<PreparedContact>>>,
+}
+
+/// Profiles on the track: the contact table and what is derived from it.
+#[derive(Debug)]
+pub struct PreparedContact {
+    pub(super) table: ContactTable,
+    /// Mean nominal rolling radius r₀, m.
+    pub(super) nominal_radius: f64,
+    /// Largest contact angle found in the table (the flange angle), rad.
+    pub(super) flange_angle: f64,
+}
+
+/// Material and law constants from the parameters.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Constants {
+    pub(super) radius: f64,
+    pub(super) flange_back_distance: f64,
+    pub(super) taping_offset: f64,
+    pub(super) mu: f64,
+    /// Effective modulus E*, Pa.
+    pub(super) e_star: f64,
+    /// Combined shear modulus G = E/(2(1 + ν)), Pa.
+    pub(super) shear: f64,
+    pub(super) poisson: f64,
+    pub(super) normal_damping: f64,
+    /// The creep law, its settings evaluated.
+    pub(super) creep: CreepLawSpec,
+    /// Elastic rails' support (per rail), or `None` for rigid rails.
+    pub(super) rail: Option<RailSupport>,
+}
+
+/// Where the element is on the track (after [`ForceElement::bind_track`]).
+pub(super) struct Bound {
+    pub(super) track: Arc<Track>,
+    pub(super) speed: RunningSpeed,
+    pub(super) offset: f64,
+    pub(super) contact: Arc<PreparedContact>,
+    pub(super) law: Box<dyn CreepLaw + Send + Sync>,
+    /// Nadal's limit of Y/Q for the flange angle and μ.
+    pub(super) nadal: f64,
+}
+
+impl WheelRailContact {
+    /// The element on the scenario's track: its track-following frame's arc
+    /// offset, the contact table of its profiles (see [`Self::prepare`]), the
+    /// creep law and Nadal's limit for the table's flange angle.
+    pub(super) fn bind(&self, binding: &TrackBinding) -> Result<Bound, SimError> {
+        let Some(offset) = binding
+            .body_offsets
+            .get(self.spec.wheelset)
+            .copied()
+            .flatten()
+        else {
+            return Err(self.err(
+                "the wheelset is not on a track-following frame: give its joint (or an \
+                 ancestor's) `SixDof(..., track: Some(offset))`",
+            ));
+        };
+        let contact = self.prepare(binding)?;
+        let law = self.c.creep.build().map_err(|e| self.err(e))?;
+        let nadal = nadal_limit(contact.flange_angle, self.c.mu);
+        Ok(Bound {
+            track: binding.track.clone(),
+            speed: binding.speed.clone(),
+            offset,
+            contact,
+            law,
+            nadal,
+        })
+    }
+
+    /// Places the profiles (read and validated when the model was loaded) on
+    /// the track, the rails inclined by the track's rail inclination unless
+    /// their files are drawn inclined, and builds (or reuses) the contact
+    /// table.
+    pub(super) fn prepare(&self, binding: &TrackBinding) -> Result<Arc<PreparedContact>, SimError> {
+        let track = &binding.track;
+        let t = &self.spec.table;
+        let key = format!(
+            "{:?}|{:?}|{}|{}|{}|{}|{}|{}|{}|{}|{}|{}",
+            self.spec.wheel_profiles.each_ref().map(|f| &f.path),
+            self.spec.rail_profiles.each_ref().map(|f| &f.path),
+            self.spec.rail_profiles_inclined,
+            self.c.radius,
+            self.c.flange_back_distance,
+            self.c.taping_offset,
+            track.nominal_gauge(),
+            track.rail_inclination(),
+            t.y_max,
+            t.dy,
+            t.roll_max,
+            t.droll
+        );
+        let mut tables = binding
+            .tables
+            .lock()
+            .map_err(|_| self.err("contact table cache poisoned"))?;
+        if let Some(p) = tables.get(&key) {
+            return Ok(p.clone());
+        }
+        // The profiles were read and validated when the model was loaded;
+        // here they are smoothed, the rails inclined as the track says.
+        let read = |file: &ProfileFile, inclination: f64| {
+            let settings = ProfileSettings {
+                rail_inclination: inclination,
+                ..ProfileSettings::default()
+            };
+            Profile::from_points(&file.points, &settings)
+                .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
+        };
+        let inclination = if self.spec.rail_profiles_inclined {
+            0.0
+        } else {
+            track.rail_inclination().atan()
+        };
+        let wheelset = geometry::Wheelset::new(
+            read(&self.spec.wheel_profiles[0], 0.0)?,
+            read(&self.spec.wheel_profiles[1], 0.0)?,
+            self.c.radius,
+            self.c.flange_back_distance,
+        );
+        let wheelset = geometry::Wheelset {
+            taping_line_offset: self.c.taping_offset,
+            ..wheelset
+        };
+        let rails = geometry::Track::new(
+            read(&self.spec.rail_profiles[0], inclination)?,
+            read(&self.spec.rail_profiles[1], inclination)?,
+            track.nominal_gauge(),
+        );
+        let table = ContactTable::new(
+            &wheelset,
+            &rails,
+            SearchSettings::default(),
+            TableSettings {
+                y_max: t.y_max,
+                dy: t.dy,
+                roll_max: t.roll_max,
+                droll: t.droll,
+            },
+        )
+        .map_err(|e| self.err(format!("contact table: {e}")))?;
+        let flange_angle = table
+            .rigid_functions()
+            .iter()
+            .flat_map(|r| r.sides.iter().flat_map(|s| s.as_slice().iter()))
+            .map(|c| c.contact_angle)
+            .fold(0.0, f64::max);
+        let prepared = Arc::new(PreparedContact {
+            nominal_radius: self.c.radius,
+            table,
+            flange_angle,
+        });
+        tables.insert(key, prepared.clone());
+        Ok(prepared)
+    }
+
+    /// The constants at the parameter values `params` (in
+    /// `Model::parameters` order), checked: dimensions and moduli positive,
+    /// Poisson's ratio in [0, 0.5), the elastic rails' supports valid.
+    pub(super) fn constants(&self, params: &[f64]) -> Result<Constants, SimError> {
+        let name = self.name.clone();
+        let ev = |e, field| eval_scalar(e, params, &name, field);
+        let s = &self.spec;
+        let young = ev(&s.young, "young")?;
+        let poisson = ev(&s.poisson, "poisson")?;
+        let c = Constants {
+            radius: ev(&s.radius, "radius")?,
+            flange_back_distance: ev(&s.flange_back_distance, "flange_back_distance")?,
+            taping_offset: ev(&s.taping_offset, "taping_offset")?,
+            mu: ev(&s.mu, "mu")?,
+            e_star: effective_modulus(young, poisson),
+            shear: young / (2.0 * (1.0 + poisson)),
+            poisson,
+            normal_damping: ev(&s.normal_damping, "normal_damping")?,
+            creep: s
+                .creep
+                .try_map(|key, e| eval_scalar(e, params, &name, key))?,
+            rail: match &s.rail {
+                RailKind::Rigid => None,
+                RailKind::Elastic { ky, cy, kz, cz } => Some(RailSupport {
+                    ky: ev(ky, "rail.ky")?,
+                    cy: ev(cy, "rail.cy")?,
+                    kz: ev(kz, "rail.kz")?,
+                    cz: ev(cz, "rail.cz")?,
+                }),
+            },
+        };
+        for (field, v) in [
+            ("radius", c.radius),
+            ("flange_back_distance", c.flange_back_distance),
+            ("young", young),
+        ] {
+            if v <= 0.0 {
+                return Err(self.err(format!("{field} must be positive, got {v}")));
+            }
+        }
+        if !(0.0..0.5).contains(&poisson) {
+            return Err(self.err(format!("poisson must be in [0, 0.5), got {poisson}")));
+        }
+        if c.mu < 0.0 || c.normal_damping < 0.0 || c.taping_offset < 0.0 {
+            return Err(self.err("mu, normal_damping and taping_offset must not be negative"));
+        }
+        if let Some(r) = &c.rail {
+            if !(r.ky.is_finite() && r.ky > 0.0 && r.kz.is_finite() && r.kz > 0.0) {
+                return Err(self.err(format!(
+                    "rail stiffnesses ky, kz must be positive and finite, got {} and {} N/m",
+                    r.ky, r.kz
+                )));
+            }
+            if !(r.cy.is_finite() && r.cy >= 0.0 && r.cz.is_finite() && r.cz >= 0.0) {
+                return Err(self.err(format!(
+                    "rail damping cy, cz must not be negative, got {} and {} N s/m",
+                    r.cy, r.cz
+                )));
+            }
+            // The elastic rail's equilibrium (Pogorelov 2005, Sect. 4.2) balances
+            // the Hertz force against the rail support: a damper along the
+            // contact normal has no place in it (the rail's dampers cy, cz
+            // act in series with the Hertz spring instead).
+            if c.normal_damping != 0.0 {
+                return Err(self.err(format!(
+                    "normal_damping must be 0 with elastic rails (the rail dampers cy, cz \
+                     damp the contact), got {} N s/m",
+                    c.normal_damping
+                )));
+            }
+        }
+        Ok(c)
+    }
+}

@@ -1,0 +1,276 @@
+//! The contact solve at one state: both wheels' contacts on rigid rails
+//! (Hertzian normal force from the approach, creep forces by the law), the
+//! elastic rails' solve called per side, and the last solution kept for the
+//! outputs, the Jacobian and the accepted step that ask for the same state.
+
+use super::WheelRailContact;
+use super::kinematics::ContactKinematics;
+use crate::forces::{ForceContext, ForceJacobian};
+use crate::system::SimError;
+use nalgebra::{Matrix3, Vector3};
+use railmbs_wheelrail::creep::{ContactPatch, CreepForces, Creepages};
+use railmbs_wheelrail::elastic_rail::CreepStart;
+use railmbs_wheelrail::geometry::Contact;
+use railmbs_wheelrail::kalker::KalkerCoefficients;
+
+/// One solved contact.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct ContactState {
+    /// Point of application (on the rail surface), SC0, m.
+    pub(super) point: Vector3<f64>,
+    /// Contact frame in SC0.
+    pub(super) ex: Vector3<f64>,
+    pub(super) ey: Vector3<f64>,
+    pub(super) n: Vector3<f64>,
+    /// Normal force, N.
+    pub(super) normal: f64,
+    /// dN/dδ, N/m.
+    pub(super) normal_stiffness: f64,
+    pub(super) creepages: Creepages,
+    pub(super) forces: CreepForces,
+    /// Linear creep coefficients f11 = G a b C11, f22 = G a b C22 (N), times the
+    /// saturation ratio (|F| / linear |F|, ≤ 1), for the Jacobian.
+    pub(super) f11: f64,
+    pub(super) f22: f64,
+    /// Rolling speed, m/s.
+    pub(super) speed: f64,
+    /// Contact angle, rad; lateral position of the contact on the rail (track
+    /// frame, m).
+    pub(super) angle: f64,
+    pub(super) rail_y: f64,
+    /// Rolling radius of the wheel at the contact, m.
+    pub(super) rolling_radius: f64,
+    /// Power dissipated at the contact, W: the creep forces against the
+    /// creepages, −V (F_x ξ + F_y η + M_z φ) (the forces act on the wheel and
+    /// oppose the slip), plus the normal damper's force times the approach
+    /// rate (rigid rails).
+    pub(super) dissipation: f64,
+    /// Elastic energy of the Hertz contact, (2/5) N δ (N ∝ δ^{3/2}), J.
+    pub(super) elastic_energy: f64,
+}
+
+impl ContactState {
+    /// Total force on the wheel, SC0, N.
+    pub(super) fn force(&self) -> Vector3<f64> {
+        self.n * self.normal + self.ex * self.forces.fx + self.ey * self.forces.fy
+    }
+}
+
+/// Both wheels at one state.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct WheelsetState {
+    /// Per side (left, right): contacts (up to two) and how many.
+    pub(super) contacts: [[ContactState; 2]; 2],
+    pub(super) count: [usize; 2],
+    /// Track frame axes in SC0 (columns x, y, z).
+    pub(super) track_axes: Matrix3<f64>,
+    /// Elastic rails: per rail (left, right) the displacement (d_y, d_z), m,
+    /// in the track frame; zero for rigid rails.
+    pub(super) rail_d: [[f64; 2]; 2],
+    /// Elastic rails: per rail the creep forces the rail's outer iterations
+    /// converged to (where the next step's iterations start).
+    pub(super) rail_creep: [CreepStart; 2],
+}
+
+impl WheelsetState {
+    /// The contacts of side 0 (left) or 1 (right).
+    pub(super) fn side(&self, side: usize) -> &[ContactState] {
+        &self.contacts[side][..self.count[side]]
+    }
+
+    /// Adds a loaded contact to side 0 (left) or 1 (right).
+    pub(super) fn push(&mut self, side: usize, contact: ContactState) {
+        self.contacts[side][self.count[side]] = contact;
+        self.count[side] += 1;
+    }
+}
+
+impl WheelRailContact {
+    /// [`Self::solve_new`], or the stored result for the same time and
+    /// wheelset kinematics (the axle's and, for independently rotating wheels,
+    /// the wheels', whose spin alone changes the creep forces).
+    pub(super) fn solve(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+        let body = [
+            ctx.bodies[self.spec.wheelset],
+            ctx.bodies[self.wheel_body(0)],
+            ctx.bodies[self.wheel_body(1)],
+        ];
+        if let Ok(last) = self.last.lock()
+            && let Some((t, k, state)) = last.as_ref()
+            && *t == ctx.t
+            && *k == body
+        {
+            return Ok(*state);
+        }
+        let state = self.solve_new(ctx)?;
+        if let Ok(mut last) = self.last.lock() {
+            *last = Some((ctx.t, body, state));
+        }
+        Ok(state)
+    }
+
+    /// Solves both wheels' contacts at the context's state.
+    fn solve_new(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+        let Some(b) = &self.bound else {
+            return Err(self.err(
+                "no track: a wheel–rail element needs the scenario's track (`track: (file: …)`)",
+            ));
+        };
+        let t = ctx.t;
+        let sides = self.sides(ctx, b)?;
+        let mut state = WheelsetState {
+            track_axes: sides[0].axes,
+            ..WheelsetState::default()
+        };
+        match self.c.rail {
+            None => {
+                let left = self.lookup(&sides[0], 0.0)?;
+                let right = if sides[1].y == sides[0].y {
+                    left
+                } else {
+                    self.lookup(&sides[1], 0.0)?
+                };
+                let sets: [&[Contact; 2]; 2] = [&left[0], &right[1]];
+                for (side, geo) in sides.iter().enumerate() {
+                    for c in sets[side] {
+                        let Some(k) = self.kinematics(geo, c, [0.0; 2])? else {
+                            continue;
+                        };
+                        let elastic = k
+                            .shape
+                            .normal_force(k.approach)
+                            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+                        let normal = (elastic + self.c.normal_damping * k.approach_rate).max(0.0);
+                        if normal == 0.0 {
+                            continue;
+                        }
+                        let stiffness = if elastic > 0.0 {
+                            k.shape.stiffness(k.approach)
+                        } else {
+                            0.0
+                        };
+                        let hertz = k
+                            .shape
+                            .contact(normal)
+                            .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+                        let patch = self.patch(hertz.a, hertz.b, normal);
+                        let forces = b
+                            .law
+                            .forces_at_speed(&patch, &k.creepages, k.speed)
+                            .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
+                        let damper_power = (normal - elastic) * k.approach_rate;
+                        let st = self.contact_state(
+                            &k,
+                            &patch,
+                            (normal, stiffness),
+                            forces,
+                            (damper_power, 0.4 * elastic * k.approach),
+                        )?;
+                        state.push(side, st);
+                    }
+                }
+            }
+            Some(support) => {
+                let (h, d_prev, creep) = self.rail_reference(t);
+                for (side, geo) in sides.iter().enumerate() {
+                    let start = (h, d_prev[side], &creep[side]);
+                    self.solve_elastic_side(geo, &support, start, &mut state)?;
+                }
+            }
+        }
+        Ok(state)
+    }
+
+    /// The contact patch for the creep law: semi-axes `a`, `b` (m), normal
+    /// force `n` (N).
+    pub(super) fn patch(&self, a: f64, b: f64, n: f64) -> ContactPatch {
+        ContactPatch {
+            a,
+            b,
+            g: self.c.shear,
+            nu: self.c.poisson,
+            mu: self.c.mu,
+            n,
+        }
+    }
+
+    /// The solved contact: normal force `normal` (N) with dN/dδ `stiffness`
+    /// (N/m) and the creep forces.
+    pub(super) fn contact_state(
+        &self,
+        k: &ContactKinematics,
+        patch: &ContactPatch,
+        (normal, stiffness): (f64, f64),
+        forces: CreepForces,
+        (damper_power, elastic_energy): (f64, f64),
+    ) -> Result<ContactState, SimError> {
+        // Linear creep coefficients (Kalker), scaled by the saturation of the
+        // actual forces, for the approximate Jacobian (Pogorelov 2005, Sect. 6).
+        let (f11, f22) = KalkerCoefficients::saturated_slopes(
+            patch.a,
+            patch.b,
+            self.c.shear,
+            self.c.poisson,
+            k.creepages.xi,
+            k.creepages.eta,
+            forces.fx,
+            forces.fy,
+        )
+        .ok_or_else(|| self.err("Poisson ratio outside Kalker's table"))?;
+        Ok(ContactState {
+            point: k.point,
+            ex: k.ex,
+            ey: k.ey,
+            n: k.n,
+            normal,
+            normal_stiffness: stiffness * k.cos_angle,
+            creepages: k.creepages,
+            forces,
+            f11,
+            f22,
+            speed: k.speed,
+            angle: k.angle,
+            rail_y: k.rail_y,
+            rolling_radius: k.rolling_radius,
+            dissipation: -k.speed
+                * (forces.fx * k.creepages.xi
+                    + forces.fy * k.creepages.eta
+                    + forces.mz * k.creepages.phi)
+                + damper_power,
+            elastic_energy,
+        })
+    }
+
+    /// Adds the solved contacts' approximate stiffness and damping (Pogorelov
+    /// 2005, Sect. 6) at the context's state to `jac`: the Hertz stiffness
+    /// along the normal, the linear creep coefficients over the rolling speed
+    /// along the rolling and lateral directions, the normal damper.
+    pub(super) fn add_contact_jacobian(
+        &self,
+        ctx: &ForceContext,
+        jac: &mut ForceJacobian,
+    ) -> Result<(), SimError> {
+        let state = self.solve(ctx)?;
+        for side in 0..2 {
+            for c in state.side(side) {
+                // f = N n + Fx eₓ + Fy eᵧ on the wheel at the contact point;
+                // d = wheel point − rail point (at rest): ∂N/∂d = −k n,
+                // ∂F/∂ḋ ≈ −(f11/V) eₓeₓᵀ − (f22/V) eᵧeᵧᵀ − c_n nnᵀ.
+                let nn = c.n * c.n.transpose();
+                let kq = -c.normal_stiffness * nn;
+                let kv = -(c.f11 / c.speed) * (c.ex * c.ex.transpose())
+                    - (c.f22 / c.speed) * (c.ey * c.ey.transpose())
+                    - self.c.normal_damping * nn;
+                jac.add_point_pair(
+                    None,
+                    &c.point,
+                    Some(self.wheel_body(side)),
+                    &c.point,
+                    &kq,
+                    &kv,
+                );
+            }
+        }
+        Ok(())
+    }
+}
