@@ -169,16 +169,65 @@ pub struct Plugin {
     pub fixed: Vec<(usize, f64)>,
 }
 
+/// `e` and its sources, joined by `: ` (libloading's own message is only
+/// "dlopen failed"; the system loader's reason is its source).
+fn error_chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
+
+/// Checks that `path` is a readable, complete object file before the system
+/// loader maps it: mapping a truncated library crashes the process with
+/// SIGBUS when a page past the end of the file is touched.
+fn check_library_file(path: &Path) -> Result<(), PluginError> {
+    use object::{Object, ObjectSegment};
+    let not_a_library = |reason: String| PluginError::NotALibrary {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let data = std::fs::read(path).map_err(|e| not_a_library(e.to_string()))?;
+    let file = object::File::parse(&*data)
+        .map_err(|e| not_a_library(format!("not an object file the loader can map ({e})")))?;
+    for segment in file.segments() {
+        let (offset, size) = segment.file_range();
+        let end = offset.saturating_add(size);
+        if end > data.len() as u64 {
+            return Err(not_a_library(format!(
+                "truncated: a segment ends at byte {end}, the file has {} bytes",
+                data.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl Plugin {
     /// Loads the library at `path` and reads its description (no model check).
+    /// A bare file name (`chain10.so`) is a file in the working directory, as
+    /// for any other file argument (the system loader would search its
+    /// library path instead).
     pub fn open(path: &Path) -> Result<Self, PluginError> {
+        let relative_name = path.parent().is_some_and(|p| p.as_os_str().is_empty());
+        let path = &if relative_name {
+            Path::new(".").join(path)
+        } else {
+            path.to_path_buf()
+        };
+        check_library_file(path)?;
         // SAFETY: loading runs the library's initializers; railmbs plugins have
         // none beyond the Rust runtime's. Any library can be named here, which is
-        // why the symbols and versions are checked before use.
+        // why the file was checked to be a whole object file and the symbols and
+        // versions are checked before use.
         let lib =
             unsafe { libloading::Library::new(path) }.map_err(|e| PluginError::NotALibrary {
                 path: path.to_path_buf(),
-                reason: e.to_string(),
+                reason: error_chain(&e),
             })?;
         let lib: &'static libloading::Library = Box::leak(Box::new(lib));
         let missing = |symbol: &[u8]| PluginError::MissingSymbol {

@@ -574,7 +574,7 @@ impl ContactGeometry {
             ..Default::default()
         };
         for slot in 0..count {
-            set.contacts[slot] = self.contact_at(s, ys, cs, ss, found[slot].0);
+            set.contacts[slot] = self.contact_at(k, ys, cs, ss, found[slot].0, (y, roll))?;
         }
         Ok(set)
     }
@@ -626,7 +626,7 @@ impl ContactGeometry {
                 b = b.min(split);
             }
             let (u, _) = self.refine(s, ys, cs, ss, a, b);
-            found[r] = Some(self.contact_at(s, ys, cs, ss, u));
+            found[r] = Some(self.contact_at(k, ys, cs, ss, u, (y, roll))?);
         }
         match found {
             [Some(a), Some(b)] => Ok([a, b]),
@@ -675,16 +675,35 @@ impl ContactGeometry {
         if fu.is_finite() { (u, fu) } else { (x1, f1) }
     }
 
-    fn contact_at(&self, s: &Side, ys: f64, cs: f64, ss: f64, u: f64) -> Contact {
-        let w = s.wheel.eval(u).expect("refined inside the wheel range");
+    /// The contact of wheel `k` at wheel coordinate `u` (a refined minimum
+    /// of the distance); `NoContact` at (y, roll) = `at` where the rail does
+    /// not exist below it (profiles that barely overlap, or a wheel profile
+    /// given as the rail).
+    #[allow(clippy::too_many_arguments)]
+    fn contact_at(
+        &self,
+        k: usize,
+        ys: f64,
+        cs: f64,
+        ss: f64,
+        u: f64,
+        at: (f64, f64),
+    ) -> Result<Contact, GeometryError> {
+        let s = &self.sides[k];
+        let no_contact = || GeometryError::NoContact {
+            side: if k == 0 { "left" } else { "right" },
+            y: at.0,
+            roll: at.1,
+        };
+        let w = s.wheel.eval(u).ok_or_else(no_contact)?;
         let (gap, v) = self
             .distance(s, ys, cs, ss, u, w.h, &mut 0)
-            .expect("refined where the rail exists");
-        let r = s.rail.eval(v).expect("inside the rail range");
+            .ok_or_else(no_contact)?;
+        let r = s.rail.eval(v).ok_or_else(no_contact)?;
         let delta = r.slope.atan();
         let radius = s.radius - w.h;
         let gamma_w = w.slope.atan();
-        Contact {
+        Ok(Contact {
             gap,
             wheel_u: u,
             rail_u: v,
@@ -700,7 +719,7 @@ impl ContactGeometry {
             yaw_lead: s.sign * radius * delta.tan(),
             // d = zz − h_r(v): dd/du = (sin φ + cos φ h_w') − h_r'(v)(cos φ − sin φ h_w').
             distance_slope: (ss + cs * w.slope) - r.slope * (cs - ss * w.slope),
-        }
+        })
     }
 
     /// Rigid wheelset at lateral shift `y` (m): the roll and height at which both wheels touch

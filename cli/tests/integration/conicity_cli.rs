@@ -94,3 +94,22 @@ fn conicity_writes_file_and_reports_bad_input() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("rail profile"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A wheel profile given as the rail (a two-column file says nothing about its
+/// kind) is an error with a message, not a panic (exit code 101).
+#[test]
+fn a_wheel_profile_as_the_rail_is_an_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_umsim"))
+        .args(["conicity", "--wheel"])
+        .arg(format!("{PROFILES}RUIC519A.dat"))
+        .arg("--rail")
+        .arg(format!("{PROFILES}RUIC519A.dat"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("no contact between left wheel and rail"),
+        "{stderr}"
+    );
+}

@@ -246,3 +246,45 @@ fn output_over_an_input_is_refused() {
         );
     }
 }
+
+/// `--plugin NAME.so` finds the file in the working directory (as the README
+/// writes it), and a truncated plugin is refused with its reason instead of
+/// crashing the process (SIGBUS) when the loader maps it.
+#[test]
+fn plugin_by_bare_name_and_truncated_plugins() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = root().join("models");
+    let built = Command::new(env!("CARGO_BIN_EXE_umgen"))
+        .arg(models.join("mechanisms/chain3.ron"))
+        .args(["-o", "chain3.so"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(built.status.success(), "{}", text(&built.stderr));
+    let scenario = models.join("scenarios/chain3_rk4.ron");
+    let run = |plugin: &str| {
+        Command::new(UMSIM)
+            .arg("run")
+            .arg(&scenario)
+            .args(["--plugin", plugin, "--quiet", "-o", "out.csv"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = run("chain3.so");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let whole = std::fs::read(dir.path().join("chain3.so")).unwrap();
+    std::fs::write(dir.path().join("cut.so"), &whole[..whole.len() / 2]).unwrap();
+    let o = run("cut.so");
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("cut.so: not a loadable library"),
+        "{stderr}"
+    );
+    // A missing file names the system's reason.
+    let o = run("missing.so");
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("No such file"), "{stderr}");
+}
