@@ -103,10 +103,7 @@ impl CoulombFriction {
     /// From the model's `Coulomb` spec (`railmbs_models::forces::Coulomb`).
     pub fn new(name: String, spec: &railmbs_models::forces::Coulomb) -> Self {
         let railmbs_models::forces::Coulomb {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             stiffness,
             damping,
             static_limit,
@@ -114,7 +111,7 @@ impl CoulombFriction {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [
                 stiffness.clone(),
                 damping.clone(),
@@ -301,10 +298,7 @@ impl LoadFriction {
     /// From the model's `LoadFriction` spec (`railmbs_models::forces::LoadFriction`).
     pub fn new(name: String, spec: &railmbs_models::forces::LoadFriction) -> Self {
         let railmbs_models::forces::LoadFriction {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             c1,
             c2,
             mu_static,
@@ -313,7 +307,7 @@ impl LoadFriction {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [
                 c1.clone(),
                 c2.clone(),
@@ -646,10 +640,7 @@ impl Tabulated {
     /// From the model's `Tabulated` spec (`railmbs_models::forces::Tabulated`).
     pub fn new(name: String, spec: &railmbs_models::forces::Tabulated) -> Self {
         let railmbs_models::forces::Tabulated {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             table,
             interpolation,
             damping,
@@ -657,7 +648,7 @@ impl Tabulated {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             table_expr: table.clone(),
             damping_expr: damping.clone(),
             x0_expr: free_length.clone(),
