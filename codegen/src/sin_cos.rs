@@ -48,18 +48,12 @@ mod tests {
         (got - want).abs() / ulp
     }
 
-    /// xorshift64: reproducible arguments without a dependency.
+    /// `n` reproducible arguments uniform in [−range, range) (ChaCha8 seeded
+    /// with `seed`).
     fn arguments(seed: u64, range: f64, n: usize) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                let u = (s >> 11) as f64 / (1u64 << 53) as f64;
-                (2.0 * u - 1.0) * range
-            })
-            .collect()
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n).map(|_| rng.random_range(-range..range)).collect()
     }
 
     #[test]

@@ -1,11 +1,10 @@
 //! `Coulomb`: bipolar Coulomb friction (Pogorelov 2005, Sect. 3.1).
 
-use super::{Checks, ForceSpec, ForceSyntax, body_ref};
+use super::point_pair::point_pair_syntax;
+use super::{Checks, ForceSpec, ForceSyntax, PointPair};
 use crate::expr::Expr;
 use crate::load::{Cx, Lookup, Where};
-use crate::model::BodyRef;
-use crate::raw::{Value, Vec3, some_value, zero3};
-use serde::Deserialize;
+use crate::raw::{Value, some_value};
 
 /// Bipolar Coulomb friction (Pogorelov 2005, Sect. 3.1) between two points:
 /// sticking, F = f0 + c (x − x0) + d ẋ with f0, x0 stored when sticking
@@ -13,14 +12,8 @@ use serde::Deserialize;
 /// Positive F pulls the points together.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coulomb {
-    /// Body of the first point.
-    pub body1: BodyRef,
-    /// First point, in the frame of `body1`, m.
-    pub point1: [Expr; 3],
-    /// Body of the second point.
-    pub body2: BodyRef,
-    /// Second point, in the frame of `body2`, m.
-    pub point2: [Expr; 3],
+    /// The two points.
+    pub ends: PointPair,
     /// Sticking stiffness, N/m.
     pub stiffness: Expr,
     /// Sticking damping, N s/m.
@@ -31,23 +24,17 @@ pub struct Coulomb {
     pub sliding_force: Expr,
 }
 
-/// `Coulomb(name, body1, point1, body2, point2, c, d, limit, sliding)`.
-#[derive(Debug, Deserialize)]
-#[serde(rename = "Coulomb", deny_unknown_fields)]
-pub(crate) struct RawCoulomb {
-    name: String,
-    body1: String,
-    #[serde(default = "zero3")]
-    point1: Vec3,
-    body2: String,
-    #[serde(default = "zero3")]
-    point2: Vec3,
-    c: Value,
-    #[serde(default)]
-    d: Value,
-    limit: Value,
-    #[serde(default, deserialize_with = "some_value")]
-    sliding: Option<Value>,
+point_pair_syntax! {
+    /// `Coulomb(name, body1, point1, body2, point2, c, d, limit, sliding)`.
+    #[serde(rename = "Coulomb")]
+    pub(crate) struct RawCoulomb {
+        c: Value,
+        #[serde(default)]
+        d: Value,
+        limit: Value,
+        #[serde(default, deserialize_with = "some_value")]
+        sliding: Option<Value>,
+    }
 }
 
 impl ForceSyntax for RawCoulomb {
@@ -63,17 +50,9 @@ impl ForceSyntax for RawCoulomb {
             Some(v) => cx.expr(w, "sliding", "sliding", v, false),
             None => static_limit.clone(),
         };
-        let (body1, point1, body2, point2) = cx.two_points(
-            w,
-            (&self.body1, &self.point1),
-            (&self.body2, &self.point2),
-            lookup,
-        );
+        let ends = self.ends().resolve(cx, w, lookup);
         Coulomb {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             stiffness,
             damping,
             static_limit,
@@ -84,10 +63,7 @@ impl ForceSyntax for RawCoulomb {
 
 impl ForceSpec for Coulomb {
     fn exprs_mut(&mut self, f: &mut dyn FnMut(&mut Expr)) {
-        self.point1
-            .iter_mut()
-            .chain(self.point2.iter_mut())
-            .for_each(&mut *f);
+        self.ends.exprs_mut(f);
         for e in [
             &mut self.stiffness,
             &mut self.damping,
@@ -98,8 +74,7 @@ impl ForceSpec for Coulomb {
         }
     }
     fn bodies_mut(&mut self, f: &mut dyn FnMut(&mut usize)) {
-        body_ref(&mut self.body1, f);
-        body_ref(&mut self.body2, f);
+        self.ends.bodies_mut(f);
     }
     fn check(&self, c: &mut Checks) {
         c.positive("c", &self.stiffness);

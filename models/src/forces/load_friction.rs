@@ -1,25 +1,18 @@
 //! `LoadFriction`: load-dependent friction (Pogorelov 2005, Sect. 3.1, Fig. 3).
 
-use super::{Checks, ForceSpec, ForceSyntax, body_ref};
+use super::point_pair::point_pair_syntax;
+use super::{Checks, ForceSpec, ForceSyntax, PointPair};
 use crate::expr::Expr;
 use crate::load::{Cx, Lookup, Where};
-use crate::model::BodyRef;
-use crate::raw::{Value, Vec3, some_value, zero3};
-use serde::Deserialize;
+use crate::raw::{Value, some_value};
 
 /// Load-dependent friction (Pogorelov 2005, Sect. 3.1, Fig. 3): spring c1 in
 /// series with spring c2 in parallel with friction proportional to the force
 /// in c2 (static μ0, sliding μ). x is the distance minus `free_length`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadFriction {
-    /// Body of the first point.
-    pub body1: BodyRef,
-    /// First point, in the frame of `body1`, m.
-    pub point1: [Expr; 3],
-    /// Body of the second point.
-    pub body2: BodyRef,
-    /// Second point, in the frame of `body2`, m.
-    pub point2: [Expr; 3],
+    /// The two points.
+    pub ends: PointPair,
     /// N/m.
     pub c1: Expr,
     /// N/m.
@@ -32,24 +25,18 @@ pub struct LoadFriction {
     pub free_length: Expr,
 }
 
-/// `LoadFriction(name, body1, point1, body2, point2, c1, c2, mu0, mu, x0)`.
-#[derive(Debug, Deserialize)]
-#[serde(rename = "LoadFriction", deny_unknown_fields)]
-pub(crate) struct RawLoadFriction {
-    name: String,
-    body1: String,
-    #[serde(default = "zero3")]
-    point1: Vec3,
-    body2: String,
-    #[serde(default = "zero3")]
-    point2: Vec3,
-    c1: Value,
-    c2: Value,
-    #[serde(default, deserialize_with = "some_value")]
-    mu0: Option<Value>,
-    mu: Value,
-    #[serde(default)]
-    x0: Value,
+point_pair_syntax! {
+    /// `LoadFriction(name, body1, point1, body2, point2, c1, c2, mu0, mu, x0)`.
+    #[serde(rename = "LoadFriction")]
+    pub(crate) struct RawLoadFriction {
+        c1: Value,
+        c2: Value,
+        #[serde(default, deserialize_with = "some_value")]
+        mu0: Option<Value>,
+        mu: Value,
+        #[serde(default)]
+        x0: Value,
+    }
 }
 
 impl ForceSyntax for RawLoadFriction {
@@ -65,17 +52,9 @@ impl ForceSyntax for RawLoadFriction {
             Some(v) => cx.expr(w, "mu0", "mu0", v, false),
             None => mu.clone(),
         };
-        let (body1, point1, body2, point2) = cx.two_points(
-            w,
-            (&self.body1, &self.point1),
-            (&self.body2, &self.point2),
-            lookup,
-        );
+        let ends = self.ends().resolve(cx, w, lookup);
         LoadFriction {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             c1,
             c2,
             mu_static,
@@ -87,10 +66,7 @@ impl ForceSyntax for RawLoadFriction {
 
 impl ForceSpec for LoadFriction {
     fn exprs_mut(&mut self, f: &mut dyn FnMut(&mut Expr)) {
-        self.point1
-            .iter_mut()
-            .chain(self.point2.iter_mut())
-            .for_each(&mut *f);
+        self.ends.exprs_mut(f);
         for e in [
             &mut self.c1,
             &mut self.c2,
@@ -102,8 +78,7 @@ impl ForceSpec for LoadFriction {
         }
     }
     fn bodies_mut(&mut self, f: &mut dyn FnMut(&mut usize)) {
-        body_ref(&mut self.body1, f);
-        body_ref(&mut self.body2, f);
+        self.ends.bodies_mut(f);
     }
     fn check(&self, c: &mut Checks) {
         c.positive("c1", &self.c1);

@@ -17,6 +17,9 @@ pub(crate) use crate::visit::body_ref;
 use serde::de::{self, Deserialize, Deserializer, EnumAccess, MapAccess, VariantAccess, Visitor};
 use std::fmt;
 
+pub mod point_pair;
+pub use point_pair::PointPair;
+
 /// The model syntax of a force element: what a RON constructor
 /// `Name(name: "…", …)` in a model's `forces` list deserializes to.
 pub(crate) trait ForceSyntax {

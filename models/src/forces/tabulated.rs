@@ -1,25 +1,19 @@
 //! `Tabulated`: a tabulated force–deflection characteristic (bump stops).
 
-use super::{Checks, ForceSpec, ForceSyntax, body_ref};
+use super::point_pair::point_pair_syntax;
+use super::{Checks, ForceSpec, ForceSyntax, PointPair};
 use crate::expr::Expr;
 use crate::load::{Cx, Lookup, Where};
-use crate::model::{BodyRef, Interpolation};
-use crate::raw::{Value, Vec3, zero3};
-use serde::Deserialize;
+use crate::model::Interpolation;
+use crate::raw::Value;
 
 /// Tabulated force–deflection characteristic (bump stops):
 /// F = f(x − x0) + d ẋ, with f through the rows (deflection m, force N) and
 /// extended linearly beyond the end rows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tabulated {
-    /// Body of the first point.
-    pub body1: BodyRef,
-    /// First point, in the frame of `body1`, m.
-    pub point1: [Expr; 3],
-    /// Body of the second point.
-    pub body2: BodyRef,
-    /// Second point, in the frame of `body2`, m.
-    pub point2: [Expr; 3],
+    /// The two points.
+    pub ends: PointPair,
     /// (deflection m, force N), deflection increasing.
     pub table: Vec<(Expr, Expr)>,
     /// Between the rows: straight lines, or a monotone cubic.
@@ -30,24 +24,18 @@ pub struct Tabulated {
     pub free_length: Expr,
 }
 
-/// `Tabulated(name, body1, point1, body2, point2, table, interpolation, d, x0)`.
-#[derive(Debug, Deserialize)]
-#[serde(rename = "Tabulated", deny_unknown_fields)]
-pub(crate) struct RawTabulated {
-    name: String,
-    body1: String,
-    #[serde(default = "zero3")]
-    point1: Vec3,
-    body2: String,
-    #[serde(default = "zero3")]
-    point2: Vec3,
-    table: Vec<(Value, Value)>,
-    #[serde(default)]
-    interpolation: Interpolation,
-    #[serde(default)]
-    d: Value,
-    #[serde(default)]
-    x0: Value,
+point_pair_syntax! {
+    /// `Tabulated(name, body1, point1, body2, point2, table, interpolation, d, x0)`.
+    #[serde(rename = "Tabulated")]
+    pub(crate) struct RawTabulated {
+        table: Vec<(Value, Value)>,
+        #[serde(default)]
+        interpolation: Interpolation,
+        #[serde(default)]
+        d: Value,
+        #[serde(default)]
+        x0: Value,
+    }
 }
 
 impl ForceSyntax for RawTabulated {
@@ -76,17 +64,9 @@ impl ForceSyntax for RawTabulated {
             })
             .collect();
         let damping = cx.expr(w, "d", "d", &self.d, false);
-        let (body1, point1, body2, point2) = cx.two_points(
-            w,
-            (&self.body1, &self.point1),
-            (&self.body2, &self.point2),
-            lookup,
-        );
+        let ends = self.ends().resolve(cx, w, lookup);
         Tabulated {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             table: rows,
             interpolation: self.interpolation,
             damping,
@@ -97,10 +77,7 @@ impl ForceSyntax for RawTabulated {
 
 impl ForceSpec for Tabulated {
     fn exprs_mut(&mut self, f: &mut dyn FnMut(&mut Expr)) {
-        self.point1
-            .iter_mut()
-            .chain(self.point2.iter_mut())
-            .for_each(&mut *f);
+        self.ends.exprs_mut(f);
         for (x, y) in &mut self.table {
             f(x);
             f(y);
@@ -109,8 +86,7 @@ impl ForceSpec for Tabulated {
         f(&mut self.free_length);
     }
     fn bodies_mut(&mut self, f: &mut dyn FnMut(&mut usize)) {
-        body_ref(&mut self.body1, f);
-        body_ref(&mut self.body2, f);
+        self.ends.bodies_mut(f);
     }
     fn check(&self, c: &mut Checks) {
         c.non_negative("d", &self.damping);

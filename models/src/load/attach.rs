@@ -74,19 +74,6 @@ impl Cx<'_> {
         }
     }
 
-    /// The two ends of a two-point element (see [`Cx::attach`]).
-    pub(crate) fn two_points(
-        &mut self,
-        w: &Where,
-        (body1, point1): (&str, &Vec3),
-        (body2, point2): (&str, &Vec3),
-        lookup: &Lookup,
-    ) -> (BodyRef, [Expr; 3], BodyRef, [Expr; 3]) {
-        let (b1, p1) = self.attach(w, ("body1", body1), ("point1", point1), lookup);
-        let (b2, p2) = self.attach(w, ("body2", body2), ("point2", point2), lookup);
-        (b1, p1, b2, p2)
-    }
-
     /// A frame on a body or connection point (see [`Cx::attach`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn attach_frame(

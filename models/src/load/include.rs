@@ -169,14 +169,6 @@ impl Sub<'_> {
     }
 }
 
-/// A body of the includer: one of its own (raw index) or a subsystem's
-/// (subsystem, body index in the subsystem's model).
-#[derive(Debug, Clone, Copy)]
-pub(super) enum Node {
-    Raw(usize),
-    Sub(usize, usize),
-}
-
 /// `"; close matches: \"a\", \"b\""` for the candidates close to `name`
 /// (small edit distance, or the same last part of a long name), or `""`.
 pub(super) fn close_matches<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> String {

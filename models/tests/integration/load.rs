@@ -205,13 +205,11 @@ fn force_elements() {
     assert_eq!(m.force_index("bush"), Some(1));
     match &m.forces[0].kind {
         ForceKind::Bipolar(railmbs_models::forces::Bipolar {
-            body1,
-            body2,
+            ends: railmbs_models::forces::PointPair { body1, body2, .. },
             stiffness,
             damping,
             preload,
             free_length,
-            ..
         }) => {
             assert_eq!(*body1, BodyRef::Ground);
             assert_eq!(*body2, BodyRef::Body(4));

@@ -318,10 +318,13 @@ fn forces_reach_subsystem_bodies_and_connection_points() {
     let body = |n: &str| BodyRef::Body(m.body_index(n).unwrap());
     let bipolar = |name: &str| match &m.forces[m.force_index(name).unwrap()].kind {
         ForceKind::Bipolar(railmbs_models::forces::Bipolar {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends:
+                railmbs_models::forces::PointPair {
+                    body1,
+                    point1,
+                    body2,
+                    point2,
+                },
             ..
         }) => (*body1, eval3(point1, &p), *body2, eval3(point2, &p)),
         other => panic!("{name}: {other:?}"),

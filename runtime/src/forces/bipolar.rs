@@ -7,7 +7,8 @@ use super::{
 };
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_models::{BodyRef, Expr};
+use railmbs_models::Expr;
+use railmbs_models::forces::PointPair;
 
 /// Two attachment points and the kinematics of their distance.
 #[derive(Debug, Clone)]
@@ -27,9 +28,13 @@ pub(crate) struct PairState {
 }
 
 impl TwoPoint {
-    pub fn new(b1: BodyRef, p1: &[Expr; 3], b2: BodyRef, p2: &[Expr; 3]) -> Self {
+    /// The ends of the model's point pair.
+    pub fn new(ends: &PointPair) -> Self {
         Self {
-            ends: [Attachment::new(b1, p1), Attachment::new(b2, p2)],
+            ends: [
+                Attachment::new(ends.body1, &ends.point1),
+                Attachment::new(ends.body2, &ends.point2),
+            ],
         }
     }
 
@@ -137,10 +142,7 @@ impl LinearBipolar {
     /// From the model's `Bipolar` spec (`railmbs_models::forces::Bipolar`).
     pub fn new(name: String, spec: &railmbs_models::forces::Bipolar) -> Self {
         let railmbs_models::forces::Bipolar {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             stiffness,
             damping,
             preload,
@@ -148,7 +150,7 @@ impl LinearBipolar {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [
                 stiffness.clone(),
                 damping.clone(),

@@ -103,10 +103,7 @@ impl CoulombFriction {
     /// From the model's `Coulomb` spec (`railmbs_models::forces::Coulomb`).
     pub fn new(name: String, spec: &railmbs_models::forces::Coulomb) -> Self {
         let railmbs_models::forces::Coulomb {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             stiffness,
             damping,
             static_limit,
@@ -114,7 +111,7 @@ impl CoulombFriction {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [
                 stiffness.clone(),
                 damping.clone(),
@@ -305,10 +302,7 @@ impl LoadFriction {
     /// From the model's `LoadFriction` spec (`railmbs_models::forces::LoadFriction`).
     pub fn new(name: String, spec: &railmbs_models::forces::LoadFriction) -> Self {
         let railmbs_models::forces::LoadFriction {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             c1,
             c2,
             mu_static,
@@ -317,7 +311,7 @@ impl LoadFriction {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [
                 c1.clone(),
                 c2.clone(),
@@ -654,10 +648,7 @@ impl Tabulated {
     /// From the model's `Tabulated` spec (`railmbs_models::forces::Tabulated`).
     pub fn new(name: String, spec: &railmbs_models::forces::Tabulated) -> Self {
         let railmbs_models::forces::Tabulated {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             table,
             interpolation,
             damping,
@@ -665,7 +656,7 @@ impl Tabulated {
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             table_expr: table.clone(),
             damping_expr: damping.clone(),
             x0_expr: free_length.clone(),

@@ -40,17 +40,14 @@ impl SeriesSpringDamper {
     /// From the model's `SeriesSpringDamper` spec (`railmbs_models::forces::SeriesSpringDamper`).
     pub fn new(name: String, spec: &railmbs_models::forces::SeriesSpringDamper) -> Self {
         let railmbs_models::forces::SeriesSpringDamper {
-            body1,
-            point1,
-            body2,
-            point2,
+            ends,
             stiffness,
             damping,
             preload,
         } = spec;
         Self {
             name,
-            pair: TwoPoint::new(*body1, point1, *body2, point2),
+            pair: TwoPoint::new(ends),
             exprs: [stiffness.clone(), damping.clone(), preload.clone()],
             offset: 0,
             stiffness: 0.0,

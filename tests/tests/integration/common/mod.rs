@@ -5,6 +5,8 @@ use nalgebra::{DMatrix, DVector};
 use railmbs_models::Model;
 use railmbs_runtime::integrate::{ParkSettings, Rk4Settings, integrate_park, integrate_rk4};
 use railmbs_runtime::{Equations, MechanicalSystem, ModelSystem, NumericEquations, Parts};
+use rand::{Rng as _, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
@@ -69,18 +71,15 @@ pub fn numeric_system(
     (sys, q0, v0)
 }
 
-/// Small deterministic generator (xorshift64*), uniform in [lo, hi).
-pub struct Rng(u64);
+/// Reproducible random numbers for the tests (ChaCha8 seeded with `seed`),
+/// uniform in [lo, hi).
+pub struct Rng(ChaCha8Rng);
 impl Rng {
     pub fn new(seed: u64) -> Self {
-        Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+        Self(ChaCha8Rng::seed_from_u64(seed))
     }
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
-        lo + (hi - lo) * x
+        self.0.random_range(lo..hi)
     }
     pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
         (0..n).map(|_| self.uniform(lo, hi)).collect()

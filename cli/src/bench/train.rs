@@ -1,0 +1,158 @@
+//! `umsim bench` on a train file (`Train(...)`): the evaluation times summed
+//! over its vehicles (the train's M and k are block-diagonal in the
+//! vehicles), and the whole train scenario run by `run_train` with every
+//! vehicle on the same engine.
+
+use super::report::{BenchReport, EngineTimes};
+use super::timing::{Stopwatch, median_run};
+use super::workload::{random_states, time_engine};
+use super::{Args, BenchEngine, override_creep, parse_creep};
+use crate::engine::{Engine, build_engine, build_engine_with};
+use railmbs_models::Model;
+use railmbs_runtime::Equations;
+use railmbs_runtime::train::run_train;
+use std::path::Path;
+use std::time::Instant;
+
+/// True if the file is a train (`Train(...)`, read as a scenario of either
+/// kind).
+pub(super) fn is_train_file(path: &Path) -> bool {
+    matches!(
+        railmbs_models::load_any_scenario(path),
+        Ok(railmbs_models::AnyScenario::Train(_))
+    )
+}
+
+/// Builds the engine of one vehicle's model.
+type VehicleEngines = dyn Fn(&Model) -> Result<Box<dyn Equations>, String>;
+
+/// Median time of `run_train` (no CSV) with every vehicle's engine from
+/// `make`, s, and the steps of a run.
+fn time_train_run(
+    train: &railmbs_models::TrainScenario,
+    models: &[Model],
+    make: &VehicleEngines,
+) -> Result<(f64, usize), String> {
+    let refs: Vec<&Model> = models.iter().collect();
+    median_run(|| {
+        let engines = models.iter().map(make).collect::<Result<Vec<_>, _>>()?;
+        let watch = Stopwatch::start();
+        let summary = run_train(train, &refs, engines, None, |_| {}).map_err(|e| e.to_string())?;
+        let seconds = watch.seconds();
+        match summary.error {
+            Some(e) => Err(format!("the train run failed: {e}")),
+            None => Ok((seconds, summary.steps)),
+        }
+    })
+}
+
+/// `measure` for a train file: evaluations summed over the vehicles, the
+/// train run with each engine.
+pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::error::Error>> {
+    let train = railmbs_models::load_train(&args.model)?;
+    let law = args.creep.as_deref().map(parse_creep).transpose()?;
+    let mut models = Vec::new();
+    for v in &train.vehicles {
+        let mut m = railmbs_models::load_model(&v.model)?;
+        if let Some(law) = &law {
+            override_creep(&mut m, law);
+        }
+        models.push(m);
+    }
+    if law.is_some()
+        && !models.iter().any(|m| {
+            m.forces
+                .iter()
+                .any(|f| matches!(f.kind, railmbs_models::ForceKind::WheelRail(_)))
+        })
+    {
+        return Err(format!(
+            "--creep: no vehicle of the train {} has a wheel–rail element",
+            args.model.display()
+        )
+        .into());
+    }
+    let mut numeric = EngineTimes::default();
+    let mut symbolic = EngineTimes::default();
+    let (mut derive_s, mut compile_s) = (Some(0.0), Some(0.0));
+    let add = |acc: &mut Option<f64>, x: Option<f64>| {
+        *acc = match (*acc, x) {
+            (Some(a), Some(b)) => Some(a + b),
+            _ => None,
+        }
+    };
+    let (mut numeric_sum, mut symbolic_sum) = (Some(0.0), Some(0.0));
+    for model in &models {
+        let params = model.default_parameter_values();
+        let states = random_states(model, &params, args.states);
+        let numeric_make = || build_engine(model, Engine::Numeric, None).map_err(|e| e.to_string());
+        let e = time_engine(model, &params, &states, &numeric_make)?.0;
+        add(&mut numeric_sum, Some(e));
+        if args.engine != BenchEngine::Numeric {
+            let start = Instant::now();
+            match build_engine_with(model, Engine::Symbolic, None, args.portable) {
+                Err(e) => {
+                    symbolic.note = Some(format!("unavailable: {e}"));
+                    symbolic_sum = None;
+                }
+                Ok(_) => {
+                    let build_s = start.elapsed().as_secs_f64();
+                    let g =
+                        railmbs_codegen::generate(model, &railmbs_codegen::GenerateOptions::new())?;
+                    let d = g.derive_time.as_secs_f64();
+                    add(&mut derive_s, Some(d));
+                    add(
+                        &mut compile_s,
+                        Some((build_s - d - g.emit_time.as_secs_f64()).max(0.0)),
+                    );
+                    let make = || {
+                        build_engine_with(model, Engine::Symbolic, None, args.portable)
+                            .map_err(|e| e.to_string())
+                    };
+                    add(
+                        &mut symbolic_sum,
+                        Some(time_engine(model, &params, &states, &make)?.0),
+                    );
+                }
+            }
+        }
+    }
+    numeric.eval_ns = numeric_sum;
+    let (t, n) = time_train_run(&train, &models, &|m| {
+        build_engine(m, Engine::Numeric, None).map_err(|e| e.to_string())
+    })?;
+    numeric.run_s = Some(t);
+    numeric.run_steps = Some(n);
+    if args.engine == BenchEngine::Numeric {
+        symbolic.note = Some("not requested (--engine numeric)".into());
+        (derive_s, compile_s) = (None, None);
+    } else if symbolic.note.is_none() {
+        symbolic.eval_ns = symbolic_sum;
+        let portable = args.portable;
+        let (t, n) = time_train_run(&train, &models, &move |m| {
+            build_engine_with(m, Engine::Symbolic, None, portable).map_err(|e| e.to_string())
+        })?;
+        symbolic.run_s = Some(t);
+        symbolic.run_steps = Some(n);
+    } else {
+        (derive_s, compile_s) = (None, None);
+    }
+    let name = args
+        .model
+        .file_stem()
+        .map_or("train".into(), |s| s.to_string_lossy().into_owned());
+    Ok(BenchReport {
+        model: format!("{name} (train of {})", train.vehicles.len()),
+        model_file: args.model.clone(),
+        dof: models.iter().map(|m| m.coordinates.len()).sum(),
+        bodies: models.iter().map(|m| m.bodies.len()).sum(),
+        states: args.states,
+        scenario: Some(train.source.clone()),
+        scenario_note: None,
+        numeric,
+        symbolic,
+        derive_s,
+        compile_s,
+        creep: args.creep.clone(),
+    })
+}
