@@ -46,11 +46,26 @@ pub struct ParseError {
 
 impl fmt::Display for ParseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "in expression \"{}\" at column {}: ",
-            self.text, self.column
-        )?;
+        // A long expression is quoted around the column only.
+        const QUOTE: usize = 60;
+        let chars: Vec<char> = self.text.chars().collect();
+        if chars.len() <= 2 * QUOTE {
+            write!(f, "in expression \"{}\"", self.text)?;
+        } else {
+            let at = self.column.saturating_sub(1).min(chars.len());
+            let (a, b) = (at.saturating_sub(QUOTE), (at + QUOTE).min(chars.len()));
+            let part: String = chars[a..b].iter().collect();
+            let (pre, post) = (
+                if a > 0 { "…" } else { "" },
+                if b < chars.len() { "…" } else { "" },
+            );
+            write!(
+                f,
+                "in expression \"{pre}{part}{post}\" ({} characters)",
+                chars.len()
+            )?;
+        }
+        write!(f, " at column {}: ", self.column)?;
         match &self.kind {
             ParseErrorKind::Syntax { expected, found } => {
                 write!(f, "expected {expected}, found {found}")
@@ -112,6 +127,7 @@ pub fn parse_expr_vars(
         chars: text.chars().collect(),
         pos: 0,
         depth: 0,
+        operators: 0,
         allow_time,
         vars,
         resolve,
@@ -131,6 +147,8 @@ struct Parser<'a, R> {
     pos: usize,
     /// Current nesting depth of `unary` (every recursion passes through it).
     depth: usize,
+    /// Binary operators read so far.
+    operators: usize,
     allow_time: bool,
     vars: &'a [&'a str],
     resolve: R,
@@ -139,6 +157,12 @@ struct Parser<'a, R> {
 /// Deepest nesting of parentheses, signs and powers accepted, so that
 /// pathological text gives an error instead of overflowing the stack.
 const MAX_DEPTH: usize = 200;
+
+/// Most binary operators in one expression. A chain `1+1+…` nests one level
+/// per operator in the expression tree, which later passes (evaluation,
+/// differentiation, code generation) walk recursively: 100 000 terms overflow
+/// the stack. Model expressions have tens of operators.
+const MAX_OPERATORS: usize = 1000;
 
 impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
     fn peek(&self) -> Option<char> {
@@ -173,6 +197,17 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
         )
     }
 
+    /// Counts one binary operator, failing past [`MAX_OPERATORS`].
+    fn operator(&mut self) -> Result<(), ParseError> {
+        self.operators += 1;
+        if self.operators > MAX_OPERATORS {
+            return Err(self.syntax(&format!(
+                "the end of the expression: at most {MAX_OPERATORS} operators in one expression"
+            )));
+        }
+        Ok(())
+    }
+
     fn eat(&mut self, c: char) -> bool {
         if self.peek() == Some(c) {
             self.pos += 1;
@@ -187,9 +222,11 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
         let mut lhs = self.product()?;
         loop {
             if self.eat('+') {
+                self.operator()?;
                 let rhs = self.product()?;
                 lhs = Expr::Add(Box::new(lhs), Box::new(rhs));
             } else if self.eat('-') {
+                self.operator()?;
                 let rhs = self.product()?;
                 lhs = Expr::Sub(Box::new(lhs), Box::new(rhs));
             } else {
@@ -202,9 +239,11 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
         let mut lhs = self.unary()?;
         loop {
             if self.eat('*') {
+                self.operator()?;
                 let rhs = self.unary()?;
                 lhs = Expr::Mul(Box::new(lhs), Box::new(rhs));
             } else if self.eat('/') {
+                self.operator()?;
                 let rhs = self.unary()?;
                 lhs = Expr::Div(Box::new(lhs), Box::new(rhs));
             } else {
@@ -238,6 +277,7 @@ impl<R: FnMut(&str) -> Option<usize>> Parser<'_, R> {
     fn power(&mut self) -> Result<Expr, ParseError> {
         let base = self.primary()?;
         if self.eat('^') {
+            self.operator()?;
             let exponent = self.unary()?;
             Ok(Expr::Pow(Box::new(base), Box::new(exponent)))
         } else {

@@ -232,6 +232,26 @@ fn deep_nesting_is_an_error_not_a_crash() {
     // Reasonable nesting is fine.
     let ok = format!("{}1{}", "(".repeat(50), ")".repeat(50));
     assert_eq!(parse_expr(&ok, &[], false).unwrap(), Expr::Num(1.0));
+    // A long flat chain nests one tree level per operator: refused past 1000
+    // operators (100 000 terms overflowed the stack), accepted up to it.
+    for op in ["+", "*", "-", "/"] {
+        let long = vec!["1"; 100_000].join(op);
+        let e = parse_expr(&long, &[], false).unwrap_err().to_string();
+        assert!(e.contains("at most 1000 operators"), "{op}: {e}");
+        // The message quotes the text around the column, not all of it.
+        assert!(
+            e.len() < 400 && e.contains("(199999 characters) at column 2003"),
+            "{e}"
+        );
+    }
+    // Powers nest to the right: the nesting limit comes first.
+    let e = parse_expr(&vec!["1"; 100_000].join("^"), &[], false).unwrap_err();
+    assert!(e.to_string().contains("nested"), "{e}");
+    let at_limit = vec!["1"; 1001].join("+");
+    assert_eq!(
+        parse_expr(&at_limit, &[], false).unwrap().eval(&[], 0.0),
+        1001.0
+    );
 }
 
 fn arb_expr() -> impl Strategy<Value = Expr> {
