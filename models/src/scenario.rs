@@ -1056,6 +1056,29 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
                 "points, stiffness, damping and preload must be finite".into(),
             ));
         }
+        for (field, t, what) in [
+            ("stiffness", c.stiffness, "stiffness"),
+            ("damping", c.damping, "damping"),
+            (
+                "angular_stiffness",
+                c.angular_stiffness,
+                "angular stiffness",
+            ),
+            ("angular_damping", c.angular_damping, "angular damping"),
+        ] {
+            // A negative stiffness or damping feeds energy into the train.
+            if [t.0, t.1, t.2].iter().any(|x| *x < 0.0) {
+                problems.push((
+                    field.into(),
+                    Some(c.name.clone()),
+                    element.clone(),
+                    format!(
+                        "coupler {what} must not be negative, got ({}, {}, {})",
+                        t.0, t.1, t.2
+                    ),
+                ));
+            }
+        }
         if let Some(rows) = &c.longitudinal
             && (rows.len() < 2
                 || rows.windows(2).any(|w| w[1].0 <= w[0].0)

@@ -523,4 +523,13 @@ fn train_file_errors_name_the_element_and_position() {
     let e = build(text("A.body", "mass"));
     assert!(e.contains("bad.ron:10:"), "{e}");
     assert!(e.contains("parameter \"mass\""), "{e}");
+    // A negative stiffness would feed energy into the train.
+    let negative =
+        text("A.body", "m").replace("stiffness: (1e5, 1e4, 1e4)", "stiffness: (-1e5, 1e4, 1e4)");
+    let e = parse_train(&negative, &path).unwrap_err().to_string();
+    assert!(e.contains("bad.ron:7:"), "{e}");
+    assert!(
+        e.contains("coupler stiffness must not be negative, got (-100000, 10000, 10000)"),
+        "{e}"
+    );
 }
