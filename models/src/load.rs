@@ -18,6 +18,7 @@ mod joints;
 mod parameters;
 mod values;
 pub(crate) use attach::{Lookup, Target, add3};
+pub(crate) use bodies::mass_problems;
 use include::{Connection, Includes, Loaded, Sub, close_matches};
 use joints::JointBuilder;
 pub(crate) use values::{evaluate_parameters, find_cycles};

@@ -2,7 +2,7 @@
 
 use crate::error::ModelError;
 use crate::expr::Expr;
-use crate::load::{evaluate_parameters, find_cycles};
+use crate::load::{evaluate_parameters, find_cycles, mass_problems};
 use crate::model::Model;
 use crate::parser::{ParseErrorKind, parse_expr};
 use std::path::PathBuf;
@@ -10,6 +10,33 @@ use std::path::PathBuf;
 impl Model {
     fn source_path(&self) -> PathBuf {
         self.source.clone().unwrap_or_default()
+    }
+
+    /// Checks every body's mass and inertia at the parameter values `params`
+    /// as loading checks them at the defaults (mass positive, inertia
+    /// positive definite and realizable): a scenario's or study's overrides
+    /// must not make a body impossible. `Err` lists each problem as
+    /// `body "<name>": <what is wrong>`.
+    pub fn check_body_values(&self, params: &[f64]) -> Result<(), Vec<String>> {
+        let mut problems = Vec::new();
+        for body in &self.bodies {
+            let mass = body.mass.eval(params, 0.0);
+            let inertia = body.inertia.each_ref().map(|e| e.eval(params, 0.0));
+            for (_, message) in mass_problems(mass, inertia) {
+                problems.push(format!("body \"{}\": {message}", body.name));
+            }
+            if !mass.is_finite() || inertia.iter().any(|x| !x.is_finite()) {
+                problems.push(format!(
+                    "body \"{}\": mass {mass} kg or inertia {inertia:?} kg m² is not finite",
+                    body.name
+                ));
+            }
+        }
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(problems)
+        }
     }
 
     /// Parameter names, index = `Expr::Param` index.

@@ -33,6 +33,12 @@ pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState
     let params = scenario
         .parameter_values(model)
         .map_err(|e| setup(e.to_string()))?;
+    model.check_body_values(&params).map_err(|problems| {
+        setup(format!(
+            "with the scenario's parameters, {}",
+            problems.join("; ")
+        ))
+    })?;
     let (q, v) = scenario
         .initial_state(model, &params)
         .map_err(|e| setup(e.to_string()))?;

@@ -11,3 +11,4 @@ mod force_elements_tabulated;
 mod force_elements_torsion;
 mod output_rows;
 mod outputs_accelerometer;
+mod scenario_checks;

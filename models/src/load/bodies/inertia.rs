@@ -10,66 +10,63 @@ impl Cx<'_> {
         let Some(d) = self.defaults.clone() else {
             return;
         };
-        let m = mass.eval(&d, 0.0);
-        if m.is_finite() && m <= 0.0 {
-            self.err(
-                w,
-                Some("mass"),
-                None,
-                format!("mass must be positive, got {m}"),
-            );
-        }
-        let i: Vec<f64> = inertia.iter().map(|e| e.eval(&d, 0.0)).collect();
-        if i.iter().any(|x| !x.is_finite()) {
-            return;
-        }
-        let (ixx, iyy, izz) = (i[0], i[1], i[2]);
-        // Relative slack for rounding in the defaults' expressions.
-        let slack = 1e-9 * (ixx.abs() + iyy.abs() + izz.abs());
-        for (a, b, c, na, nb, nc) in [
-            (ixx, iyy, izz, "ixx", "iyy", "izz"),
-            (iyy, izz, ixx, "iyy", "izz", "ixx"),
-            (izz, ixx, iyy, "izz", "ixx", "iyy"),
-        ] {
-            if a + b < c - slack {
-                self.err(
-                    w,
-                    Some("inertia"),
-                    None,
-                    format!(
-                        "inertia violates the triangle inequality: {na} + {nb} = {} < {nc} = {c}",
-                        a + b
-                    ),
-                );
-                return;
-            }
-        }
-        let ev = sym3_eigenvalues([[ixx, i[3], i[4]], [i[3], iyy, i[5]], [i[4], i[5], izz]]);
-        if ev.iter().any(|&l| l <= 0.0) {
-            self.err(
-                w,
-                Some("inertia"),
-                None,
-                format!(
-                    "inertia tensor is not positive definite: principal moments {:?} kg m²",
-                    ev
-                ),
-            );
-            return;
-        }
-        let [a, b, c] = ev;
-        if a + b < c - slack || b + c < a - slack || c + a < b - slack {
-            self.err(
-                w,
-                Some("inertia"),
-                None,
-                format!(
-                    "inertia violates the triangle inequality for its principal moments {:?} kg m²",
-                    ev
-                ),
-            );
+        let i = inertia.each_ref().map(|e| e.eval(&d, 0.0));
+        for (field, message) in mass_problems(mass.eval(&d, 0.0), i) {
+            self.err(w, Some(field), None, message);
         }
     }
+}
+
+/// What is wrong with a body of mass `m` (kg) and inertia `i` (kg m²: ixx,
+/// iyy, izz, ixy, ixz, iyz): (field, message) for a mass that is not
+/// positive, an inertia tensor that is not positive definite or whose
+/// principal moments violate the triangle inequality (no rigid body has
+/// them). Non-finite values are left to the callers' own finiteness checks.
+pub(crate) fn mass_problems(m: f64, i: [f64; 6]) -> Vec<(&'static str, String)> {
+    let mut problems = Vec::new();
+    if m.is_finite() && m <= 0.0 {
+        problems.push(("mass", format!("mass must be positive, got {m}")));
+    }
+    if i.iter().any(|x| !x.is_finite()) {
+        return problems;
+    }
+    let (ixx, iyy, izz) = (i[0], i[1], i[2]);
+    // Relative slack for rounding in the parameters' expressions.
+    let slack = 1e-9 * (ixx.abs() + iyy.abs() + izz.abs());
+    for (a, b, c, na, nb, nc) in [
+        (ixx, iyy, izz, "ixx", "iyy", "izz"),
+        (iyy, izz, ixx, "iyy", "izz", "ixx"),
+        (izz, ixx, iyy, "izz", "ixx", "iyy"),
+    ] {
+        if a + b < c - slack {
+            problems.push((
+                "inertia",
+                format!(
+                    "inertia violates the triangle inequality: {na} + {nb} = {} < {nc} = {c}",
+                    a + b
+                ),
+            ));
+            return problems;
+        }
+    }
+    let ev = sym3_eigenvalues([[ixx, i[3], i[4]], [i[3], iyy, i[5]], [i[4], i[5], izz]]);
+    if ev.iter().any(|&l| l <= 0.0) {
+        problems.push((
+            "inertia",
+            format!("inertia tensor is not positive definite: principal moments {ev:?} kg m²"),
+        ));
+        return problems;
+    }
+    let [a, b, c] = ev;
+    if a + b < c - slack || b + c < a - slack || c + a < b - slack {
+        problems.push((
+            "inertia",
+            format!(
+                "inertia violates the triangle inequality for its principal moments {ev:?} kg m²"
+            ),
+        ));
+    }
+    problems
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending (closed form, O. K. Smith,

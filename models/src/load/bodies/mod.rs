@@ -12,6 +12,7 @@
 use super::*;
 
 mod inertia;
+pub(crate) use inertia::mass_problems;
 mod resolve;
 mod tree;
 
