@@ -192,6 +192,16 @@ pub fn evaluate<R: Read, W: Write>(
         let f = law
             .forces(&patch, &c)
             .map_err(|e| format!("{source}: row {row} (line {line}): {e}"))?;
+        if !(f.fx.is_finite() && f.fy.is_finite() && f.mz.is_finite()) {
+            return Err(format!(
+                "{source}: row {row} (line {line}): {} gives a non-finite result ({}, {}, {}) \
+                 for this case; nothing is written for it",
+                law.name(),
+                f.fx,
+                f.fy,
+                f.mz
+            ));
+        }
         // `+ 0.0` turns −0 into 0 in the output.
         wr.write_record([
             (f.fx + 0.0).to_string(),

@@ -109,6 +109,10 @@ fn bad(name: &'static str, value: f64, expected: &'static str) -> CreepError {
     }
 }
 
+/// Largest magnitude of a creepage (ξ, η, and the spin made dimensionless
+/// by the patch, φ√(ab)) that the laws accept, –.
+pub const MAX_CREEPAGE: f64 = 1e6;
+
 /// Validates a patch and creepages; returns Kalker's coefficients for them.
 #[inline]
 pub(crate) fn validate(p: &ContactPatch, c: &Creepages) -> Result<KalkerCoefficients, CreepError> {
@@ -138,6 +142,18 @@ pub(crate) fn validate(p: &ContactPatch, c: &Creepages) -> Result<KalkerCoeffici
     }
     if !c.phi.is_finite() {
         return Err(bad("phi", c.phi, "finite, 1/m"));
+    }
+    // Beyond this the contact is no longer rolling (a wheel spinning or
+    // skidding a million times faster than it rolls), and the laws' squares
+    // overflow from about 1e100 on (NaN or zero forces).
+    if c.xi.abs() > MAX_CREEPAGE {
+        return Err(bad("xi", c.xi, "at most 1e6 in magnitude"));
+    }
+    if c.eta.abs() > MAX_CREEPAGE {
+        return Err(bad("eta", c.eta, "at most 1e6 in magnitude"));
+    }
+    if c.phi.abs() * (p.a * p.b).sqrt() > MAX_CREEPAGE {
+        return Err(bad("phi", c.phi, "at most 1e6/√(ab) in magnitude, 1/m"));
     }
     KalkerCoefficients::interpolate_ab(p.a, p.b, p.nu).ok_or(bad("nu", p.nu, "in [0, 0.5]"))
 }

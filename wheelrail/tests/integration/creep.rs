@@ -454,11 +454,33 @@ fn bad_input_is_named() {
                 "eta",
             ),
             (p, Creepages { phi: f64::NAN, ..c }, "phi"),
+            // Past rolling contact (and where the laws' squares overflowed
+            // to NaN or zero forces from about 1e100 on).
+            (p, Creepages { xi: 1e100, ..c }, "xi"),
+            (p, Creepages { eta: -2e6, ..c }, "eta"),
+            (p, Creepages { phi: 1e300, ..c }, "phi"),
         ] {
             match law.forces(&q, &cc) {
                 Err(CreepError::Input { name: n, .. }) => assert_eq!(n, name),
                 other => panic!("{}: expected error for {name}, got {other:?}", law.name()),
             }
+        }
+        // Up to the limit the saturating laws stay within μN (Kalker's
+        // linear law does not saturate).
+        let huge = Creepages {
+            xi: 1e6,
+            eta: -1e6,
+            phi: 0.0,
+        };
+        let f = law.forces(&p, &huge).unwrap();
+        assert!(
+            f.fx.is_finite() && f.fy.is_finite() && f.mz.is_finite(),
+            "{}: {f:?}",
+            law.name()
+        );
+        if law.name() != "kalker" {
+            let limit = p.mu * p.n * (1.0 + 1e-9);
+            assert!(f.fx.hypot(f.fy) <= limit, "{}: {f:?}", law.name());
         }
         // Zero load: zero force, no NaN.
         let f = law.forces(&ContactPatch { n: 0.0, ..p }, &c).unwrap();
