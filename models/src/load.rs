@@ -243,6 +243,7 @@ impl Cx<'_> {
             }
         }
         self.check_instance_values(&subs, &bodies, &coordinates, &cut_joints, &forces);
+        self.check_contacts_can_move(&raw, &bodies, &coordinates, &forces);
         let model = Model {
             track_frames,
             name: raw.name.clone(),
@@ -256,6 +257,49 @@ impl Cx<'_> {
             forces,
         };
         Loaded { model, connections }
+    }
+
+    /// A wheel–rail element of this file needs a wheelset that can move: the
+    /// wheelset body or one of its ancestors has a coordinate. Without one
+    /// the contact's stiff normal force acts on nothing that yields (a wheel
+    /// load of 10¹⁰ N). Subsystems' elements were checked in their own files.
+    fn check_contacts_can_move(
+        &mut self,
+        raw: &RawModel,
+        bodies: &[Body],
+        coordinates: &[Coordinate],
+        forces: &[ForceElement],
+    ) {
+        let can_move = |mut b: usize| loop {
+            if coordinates.iter().any(|c| c.body == b) {
+                return true;
+            }
+            match bodies.get(b).map(|body| body.parent) {
+                Some(BodyRef::Body(p)) if p != b => b = p,
+                _ => return false,
+            }
+        };
+        for f in forces {
+            let ForceKind::WheelRail(spec) = &f.kind else {
+                continue;
+            };
+            if !raw.forces.iter().any(|r| r.name() == f.name) || spec.wheelset >= bodies.len() {
+                continue;
+            }
+            if !can_move(spec.wheelset) {
+                self.err(
+                    &Where::Elem(FORCE, f.name.clone(), 0),
+                    Some("wheelset"),
+                    None,
+                    format!(
+                        "the wheelset body \"{}\" cannot move: neither it nor a body it is \
+                         attached to has a coordinate, so the contact would press on a fixed \
+                         body (give its joint degrees of freedom)",
+                        bodies[spec.wheelset].name
+                    ),
+                );
+            }
+        }
     }
 
     /// The values of the subsystems' elements are finite with the defaults of

@@ -186,3 +186,35 @@ fn a_rail_profile_given_for_the_wheel_is_a_load_error() {
     );
     assert_eq!(errors.len(), 1, "{errors}");
 }
+
+/// A wheel–rail element on a body that cannot move (no coordinate on it or
+/// on a body it hangs from) is refused at its wheelset field: the contact
+/// would press on a fixed body and report wheel loads of 10¹⁰ N.
+#[test]
+fn a_wheelset_that_cannot_move_is_refused() {
+    let (wheel, rail) = (
+        bundled("MBench_S1002_v3.prw"),
+        bundled("MBench_UIC60_v3.prr"),
+    );
+    // Body "a" turns about Z (coordinate qa): accepted.
+    load(&with(&element(&wheel, &rail))).unwrap();
+    // A body "fixed" welded to the ground.
+    let fixed = with(&element(&wheel, &rail).replace("wheelset: \"a\"", "wheelset: \"fixed\""))
+        .replacen(
+            "    ],\n    cut_joints",
+            "        Body(name: \"fixed\", mass: 1, inertia: (ixx: 1, iyy: 1, izz: 1),\n             \
+             joint: Joint(parent: \"ground\", transforms: [Tz(0.5)])),\n    ],\n    cut_joints",
+            1,
+        );
+    let errors = errors_of(&fixed);
+    let e = find(
+        &errors,
+        "force \"wr\"",
+        "the wheelset body \"fixed\" cannot move",
+    );
+    // At the element's `wheelset` field.
+    let off = fixed.find("wheelset: \"fixed\"").unwrap();
+    let line = fixed[..off].matches('\n').count() + 1;
+    let col = off - fixed[..off].rfind('\n').map_or(0, |p| p + 1) + 1;
+    assert_eq!(e.position, Some((line, col)), "{e}");
+}
