@@ -1,4 +1,5 @@
-//! `umsim run SCENARIO.ron [--engine numeric|symbolic] [--plugin FILE] [-o out.csv]`.
+//! `umsim run SCENARIO.ron [--engine numeric|symbolic] [--plugin FILE] [-o out.csv]
+//! [--set NAME=VALUE]… [--end-time SECONDS]`.
 
 use crate::engine::{Engine, build_engine};
 use railmbs_runtime::run::{RunSummary, run_scenario};
@@ -22,14 +23,49 @@ pub struct Args {
     /// No progress bar and no summary table.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Sets a model parameter for this run, `NAME=VALUE` (VALUE an expression
+    /// over the parameters, in the parameter's own unit, SI); repeatable, and
+    /// it replaces the scenario's own assignment of NAME.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    pub set: Vec<(String, String)>,
+    /// Runs to this end time instead of the scenario's, s.
+    #[arg(long, value_name = "SECONDS")]
+    pub end_time: Option<f64>,
+}
+
+/// `NAME=VALUE` of `--set`.
+fn parse_assignment(text: &str) -> Result<(String, String), String> {
+    match text.split_once('=') {
+        Some((name, value)) if !name.trim().is_empty() && !value.trim().is_empty() => {
+            Ok((name.trim().to_string(), value.trim().to_string()))
+        }
+        _ => Err(format!("expected NAME=VALUE, got {text:?}")),
+    }
 }
 
 /// Runs `umsim run`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let scenario = match railmbs_models::load_any_scenario(&args.scenario)? {
+    let mut scenario = match railmbs_models::load_any_scenario(&args.scenario)? {
         railmbs_models::AnyScenario::Single(s) => s,
-        railmbs_models::AnyScenario::Train(t) => return run_train(args, &t),
+        railmbs_models::AnyScenario::Train(t) => {
+            if !args.set.is_empty() || args.end_time.is_some() {
+                return Err(format!(
+                    "{}: --set and --end-time apply to scenario files, not yet to train files",
+                    args.scenario.display()
+                )
+                .into());
+            }
+            return run_train(args, &t);
+        }
     };
+    for (name, value) in &args.set {
+        scenario.set_parameter(name, value);
+    }
+    if let Some(t) = args.end_time {
+        scenario
+            .set_end_time(t)
+            .map_err(|e| format!("--end-time: {e}"))?;
+    }
     let model = railmbs_models::load_model(&scenario.model)?;
     let engine = if args.plugin.is_some() {
         Engine::Symbolic

@@ -388,6 +388,78 @@ fn readable(x: f64) -> String {
     }
 }
 
+/// Why a run of `end_time` (s) with `integrator` and output `interval` (s)
+/// could not finish or would fill the disk: (field, message) for more than
+/// [`MAX_OUTPUT_ROWS`] rows or [`MAX_STEPS`] steps, or an RK4 step longer
+/// than the run. Values that are not positive and finite are left to their
+/// own checks.
+pub fn run_limit_problems(
+    end_time: f64,
+    integrator: &IntegratorSpec,
+    interval: f64,
+) -> Vec<(&'static str, String)> {
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    let mut problems = Vec::new();
+    if !positive(end_time) {
+        return problems;
+    }
+    match *integrator {
+        IntegratorSpec::Rk4 { step } if positive(step) => {
+            if step > end_time {
+                problems.push((
+                    "step",
+                    format!(
+                        "RK4 step {} s is longer than the run (end_time {} s); a fixed-step \
+                         explicit method needs many steps per period of the fastest motion",
+                        readable(step),
+                        readable(end_time)
+                    ),
+                ));
+            }
+            if end_time / step > MAX_STEPS {
+                problems.push((
+                    "step",
+                    format!(
+                        "RK4 step {} s over end_time {} s would take {:.3e} steps \
+                         (at most {MAX_STEPS:e})",
+                        readable(step),
+                        readable(end_time),
+                        end_time / step
+                    ),
+                ));
+            }
+        }
+        IntegratorSpec::Park { max_step, .. }
+            if positive(max_step) && end_time / max_step > MAX_STEPS =>
+        {
+            problems.push((
+                "max_step",
+                format!(
+                    "max_step {} s over end_time {} s would take at least {:.3e} steps \
+                     (at most {MAX_STEPS:e})",
+                    readable(max_step),
+                    readable(end_time),
+                    end_time / max_step
+                ),
+            ));
+        }
+        _ => {}
+    }
+    let rows = end_time / interval;
+    if positive(interval) && rows > MAX_OUTPUT_ROWS {
+        problems.push((
+            "interval",
+            format!(
+                "end_time {} s with output interval {} s would write {rows:.3e} rows \
+                 (at most {MAX_OUTPUT_ROWS:e}): choose a longer interval",
+                readable(end_time),
+                readable(interval)
+            ),
+        ));
+    }
+    problems
+}
+
 /// Validates the parts common to `Scenario` and `Train` files (`check`
 /// records an error at the first `key:` of the file when `ok` is false).
 fn common(
@@ -405,36 +477,12 @@ fn common(
         "end_time",
         format!("end_time must be positive and finite, got {} s", end_time),
     );
-    // Steps a run needs at the least with steps of at most `h`.
-    let too_many_steps = |h: f64| positive(end_time) && positive(h) && end_time / h > MAX_STEPS;
     let integrator = match raw_integrator {
         RawIntegrator::Rk4 { step } => {
             check(
                 positive(step),
                 "step",
                 format!("integrator step must be positive and finite, got {step} s"),
-            );
-            check(
-                !(positive(end_time) && step > end_time),
-                "step",
-                format!(
-                    "RK4 step {} s is longer than the run (end_time {} s); \
-                     a fixed-step explicit method needs many steps per period of the \
-                     fastest motion",
-                    readable(step),
-                    readable(end_time)
-                ),
-            );
-            check(
-                !too_many_steps(step),
-                "step",
-                format!(
-                    "RK4 step {} s over end_time {} s would take {:.3e} steps \
-                     (at most {MAX_STEPS:e})",
-                    readable(step),
-                    readable(end_time),
-                    end_time / step
-                ),
             );
             IntegratorSpec::Rk4 { step }
         }
@@ -460,17 +508,6 @@ fn common(
                 "max_step",
                 format!("integrator max_step must be positive and finite, got {max_step} s"),
             );
-            check(
-                !too_many_steps(max_step),
-                "max_step",
-                format!(
-                    "max_step {} s over end_time {} s would take at least \
-                     {:.3e} steps (at most {MAX_STEPS:e})",
-                    readable(max_step),
-                    readable(end_time),
-                    end_time / max_step
-                ),
-            );
             if let Some(h) = initial_step {
                 check(
                     positive(h),
@@ -495,17 +532,9 @@ fn common(
             raw_output.interval
         ),
     );
-    let rows = end_time / raw_output.interval;
-    check(
-        !(positive(end_time) && positive(raw_output.interval) && rows > MAX_OUTPUT_ROWS),
-        "interval",
-        format!(
-            "end_time {} s with output interval {} s would write {rows:.3e} rows \
-             (at most {MAX_OUTPUT_ROWS:e}): choose a longer interval",
-            readable(end_time),
-            readable(raw_output.interval)
-        ),
-    );
+    for (field, message) in run_limit_problems(end_time, &integrator, raw_output.interval) {
+        check(false, field, message);
+    }
     let track = raw_track.map(|t| {
         let profile_speed = t.speed_profile.first().map(|k| k.1);
         check(
@@ -632,6 +661,36 @@ impl Scenario {
         e.file = self.source.clone();
         e.position = self.locate(literal);
         e
+    }
+
+    /// Replaces the end time (s) by `end_time`, checked like the file's own
+    /// (`umsim run --end-time`, studies): positive, finite, and within the
+    /// run limits with this scenario's integrator and output interval.
+    ///
+    /// # Errors
+    /// What is wrong, in one message.
+    pub fn set_end_time(&mut self, end_time: f64) -> Result<(), String> {
+        if !(end_time.is_finite() && end_time > 0.0) {
+            return Err(format!(
+                "end time must be positive and finite, got {end_time} s"
+            ));
+        }
+        let problems = run_limit_problems(end_time, &self.integrator, self.output.interval);
+        if let Some((_, message)) = problems.into_iter().next() {
+            return Err(message);
+        }
+        self.end_time = end_time;
+        Ok(())
+    }
+
+    /// Sets parameter `name` to the expression `value` (over the model's
+    /// parameters), replacing the file's own assignment of it if any
+    /// (`umsim run --set`); checked with the model when the run is prepared.
+    pub fn set_parameter(&mut self, name: &str, value: &str) {
+        match self.parameters.iter_mut().find(|(n, _)| n == name) {
+            Some((_, v)) => *v = value.to_string(),
+            None => self.parameters.push((name.to_string(), value.to_string())),
+        }
     }
 
     /// Parameter values of `model` with this scenario's macros and overrides;

@@ -288,3 +288,58 @@ fn plugin_by_bare_name_and_truncated_plugins() {
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("No such file"), "{stderr}");
 }
+
+/// `--end-time` shortens the run (checked like the file's own end time) and
+/// `--set NAME=VALUE` changes a parameter: `g=2*4.905` is the file's own
+/// 9.81 m/s² (doubling is exact in binary) and reproduces the run bit for
+/// bit; `g=0` changes it.
+#[test]
+fn end_time_and_set_override_the_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "models/scenarios/double_pendulum.ron",
+            "--quiet",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        umsim(&args)
+    };
+    let o = run(&["--end-time", "0.5"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (_, rows) = read_csv(&out);
+    assert_eq!(rows.len(), 51, "0.5 s at 0.01 s");
+    let o = run(&["--end-time", "0.5", "--set", "g=2*4.905"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(read_csv(&out).1, rows, "the same g");
+    let o = run(&["--end-time", "0.5", "--set", "g=0"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let (_, weightless) = read_csv(&out);
+    assert_eq!(weightless[0], rows[0], "the same initial state");
+    assert!(
+        (weightless[50][1] - rows[50][1]).abs() > 1e-3,
+        "gravity matters"
+    );
+    let o = run(&["--end-time", "1e20"]);
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--end-time: RK4 step 0.001 s over end_time 1e20 s"),
+        "{stderr}"
+    );
+    let o = run(&["--set", "gravity=1"]);
+    let stderr = text(&o.stderr);
+    assert!(
+        stderr.contains("parameter \"gravity\": unknown parameter"),
+        "{stderr}"
+    );
+    let o = run(&["--set", "g"]);
+    assert!(
+        text(&o.stderr).contains("expected NAME=VALUE"),
+        "{}",
+        text(&o.stderr)
+    );
+}

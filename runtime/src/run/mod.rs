@@ -52,6 +52,10 @@ pub enum RunError {
     /// The simulation itself failed before it started (a bad initial state).
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The scenario does not fit its model (an unknown parameter, macro or
+    /// coordinate), located in the scenario file.
+    #[error(transparent)]
+    Model(#[from] railmbs_models::ModelErrors),
 }
 
 /// What a finished (or stopped) run did.

@@ -30,18 +30,14 @@ pub fn scenario_state(scenario: &Scenario, model: &Model) -> Result<InitialState
         file: scenario.source.clone(),
         message,
     };
-    let params = scenario
-        .parameter_values(model)
-        .map_err(|e| setup(e.to_string()))?;
+    let params = scenario.parameter_values(model)?;
     model.check_body_values(&params).map_err(|problems| {
         setup(format!(
             "with the scenario's parameters, {}",
             problems.join("; ")
         ))
     })?;
-    let (q, v) = scenario
-        .initial_state(model, &params)
-        .map_err(|e| setup(e.to_string()))?;
+    let (q, v) = scenario.initial_state(model, &params)?;
     if let Some(i) = q.iter().chain(&v).position(|x| !x.is_finite()) {
         return Err(setup(format!(
             "initial state of model \"{}\" is not finite (entry {i}); check the init/vel expressions",
