@@ -94,10 +94,11 @@ fn progress_bar(args: &Args) -> Option<indicatif::ProgressBar> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} t = {msg} s",
+            "{spinner} [{elapsed_precise}] {wide_bar} t = {msg} s, {eta} left",
         )
         .expect("valid progress template"),
     );
+    bar.set_message("0.000");
     Some(bar)
 }
 
