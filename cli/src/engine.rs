@@ -3,6 +3,7 @@
 use railmbs_codegen::{BuiltPlugin, GenerateOptions};
 use railmbs_models::Model;
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
+use std::io::IsTerminal;
 use std::path::Path;
 
 /// Which engine computes the equations of motion.
@@ -22,7 +23,27 @@ pub fn build_symbolic(
 ) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
     let mut opts = GenerateOptions::new();
     opts.portable = portable;
-    let built = railmbs_codegen::build_plugin(model, &opts, None)?;
+    // On a terminal, say why the first run of a model waits (derivation and
+    // rustc take seconds to minutes; later runs find the plugin cached).
+    let terminal = std::io::stderr().is_terminal();
+    if terminal {
+        eprint!(
+            "umsim: symbolic equations of model \"{}\": deriving, then compiling unless cached…",
+            model.name
+        );
+    }
+    let built = railmbs_codegen::build_plugin(model, &opts, None);
+    if terminal {
+        match &built {
+            Ok(b) if b.cache_hit => eprintln!(" cached"),
+            Ok(b) => eprintln!(
+                " compiled in {:.1} s",
+                b.compile_time.map_or(0.0, |d| d.as_secs_f64())
+            ),
+            Err(_) => eprintln!(),
+        }
+    }
+    let built = built?;
     if let Some(damage) = &built.rebuilt_damaged {
         eprintln!("umsim: warning: rebuilt a damaged plugin cache entry: {damage}");
     }
