@@ -26,7 +26,7 @@ use crate::forces::{
 };
 use crate::model_system::ModelSystem;
 use crate::run::assessment::LoadSample;
-use crate::run::columns::{Columns, arc_position, columns};
+use crate::run::columns::{ARC_COLUMNS, Columns, arc_motion, columns};
 use crate::run::grid::Row;
 use crate::run::scenario::{
     check_integrator, continuous_velocities, drive_track_frames, scenario_state,
@@ -496,7 +496,8 @@ impl RowColumns<TrainSystem> for TrainColumns {
         scratch: &mut Vec<f64>,
     ) -> Result<(), RunError> {
         if let Some((arc, offset)) = &self.arc {
-            values.push(arc_position(arc, row.t)? - offset);
+            let [s, v] = arc_motion(arc, row.t)?;
+            values.extend([s - offset, v]);
         }
         for (k, cols) in self.vehicles.iter().enumerate() {
             let vehicle_row = row.slice(train.range(k));
@@ -548,7 +549,8 @@ pub fn build_train(
         .map_err(|e| setup(e.to_string()))?;
     let mut vehicles = Vec::new();
     let mut columns_all = Vec::new();
-    let mut header = vec!["time".to_string(), "s[m]".to_string()];
+    let mut header = vec!["time".to_string()];
+    header.extend(ARC_COLUMNS.map(String::from));
     let (mut q0, mut v0, mut breakpoints) = (Vec::new(), Vec::new(), Vec::new());
     let mut arc = None;
     // Contact tables built for one vehicle serve the others.

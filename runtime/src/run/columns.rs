@@ -14,8 +14,9 @@ use std::path::Path;
 /// Column layout of the output file.
 pub(crate) struct Columns {
     pub(crate) header: Vec<String>,
-    /// The running speed law, when the run is on a track: the column `s[m]`
-    /// (arc position of the vehicle's reference point) follows `time`.
+    /// The running speed law, when the run is on a track: the columns `s[m]`
+    /// (arc position of the vehicle's reference point) and `v[m/s]` (its
+    /// running speed) follow `time`.
     arc: Option<RunningSpeed>,
     coordinates: bool,
     velocities: bool,
@@ -59,7 +60,7 @@ pub(crate) fn columns(
 ) -> Result<Columns, RunError> {
     let mut header = vec!["time".to_string()];
     if arc.is_some() {
-        header.push("s[m]".to_string());
+        header.extend(ARC_COLUMNS.map(String::from));
     }
     if spec.coordinates {
         header.extend(model.coordinates.iter().map(|c| c.name.clone()));
@@ -243,16 +244,20 @@ impl RowColumns<ModelSystem> for Columns {
         scratch: &mut Vec<f64>,
     ) -> Result<(), RunError> {
         if let Some(arc) = &self.arc {
-            values.push(arc_position(arc, row.t)?);
+            values.extend(arc_motion(arc, row.t)?);
         }
         self.values(system, row.slice(0..row.q.len()), values, scratch)
     }
 }
 
-/// Arc position s(t) of a speed law, m.
-pub(crate) fn arc_position(arc: &RunningSpeed, t: f64) -> Result<f64, RunError> {
+/// The columns of a run on a track after `time`: arc position and running
+/// speed of the reference point.
+pub(crate) const ARC_COLUMNS: [&str; 2] = ["s[m]", "v[m/s]"];
+
+/// Arc position s(t) (m) and running speed v(t) (m/s) of a speed law.
+pub(crate) fn arc_motion(arc: &RunningSpeed, t: f64) -> Result<[f64; 2], RunError> {
     use railmbs_track::SpeedLaw;
     arc.motion(t)
-        .map(|m| m.s)
+        .map(|m| [m.s, m.s_dot])
         .map_err(|e| RunError::Sim(SimError::Other(e.to_string())))
 }
