@@ -1,45 +1,14 @@
 //! `umsim run` end to end: output file layout, summary, and the errors a user
 //! meets (missing file, unknown parameter, a simulation that blows up).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::{text, umsim};
+use railmbs_testkit::{Table, repo_path};
+use std::path::Path;
 
-const UMSIM: &str = env!("CARGO_BIN_EXE_umsim");
-
-/// The repository root (the bundled models live in `models/`).
-fn root() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
-}
-
-fn umsim(args: &[&str]) -> Output {
-    Command::new(UMSIM)
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("umsim starts")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Header and rows of a CSV output file.
+/// Header (joined by commas) and rows of a CSV output file.
 fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
-    let content = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let mut lines = content.lines();
-    let header = lines.next().expect("a header line").to_string();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|x| {
-                    x.parse::<f64>()
-                        .unwrap_or_else(|e| panic!("{x:?} in {l:?}: {e}"))
-                })
-                .collect()
-        })
-        .collect();
-    (header, rows)
+    let table = Table::read(path);
+    (table.header.join(","), table.rows)
 }
 
 #[test]
@@ -99,7 +68,7 @@ fn missing_scenario_file_is_named_in_the_error() {
 #[test]
 fn unknown_scenario_parameter_is_named_with_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let model = root().join("models/mechanisms/chain3.ron");
+    let model = repo_path("models/mechanisms/chain3.ron");
     let scenario = dir.path().join("bad_parameter.ron");
     std::fs::write(
         &scenario,
