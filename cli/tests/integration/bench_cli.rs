@@ -1,21 +1,7 @@
 //! `umsim bench` end to end: the JSON report.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-const UMSIM: &str = env!("CARGO_BIN_EXE_umsim");
-
-fn root() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
-}
-
-fn umsim(args: &[&str]) -> Output {
-    Command::new(UMSIM)
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("umsim starts")
-}
+use crate::common::umsim;
+use std::process::Output;
 
 fn json(o: &Output) -> serde_json::Value {
     let stdout = String::from_utf8_lossy(&o.stdout);

@@ -2,21 +2,16 @@
 //! reference case E1 (wheels A/A on rail A, diameters 920 mm, gauge 1435.16 mm), tolerance
 //! min(0.05, 0.5 tan γe) (Annex F).
 
+use railmbs_testkit::{model_path, reference_path};
 use std::process::Command;
-
-const PROFILES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/profiles/en15302/");
-const E1: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/reference/conicity/ben_E1.dat"
-);
 
 #[test]
 fn conicity_e1_matches_en15302_reference() {
     let out = Command::new(env!("CARGO_BIN_EXE_umsim"))
         .args(["conicity", "--wheel"])
-        .arg(format!("{PROFILES}RUIC519A.dat"))
+        .arg(model_path("profiles/en15302/RUIC519A.dat"))
         .arg("--rail")
-        .arg(format!("{PROFILES}SUIC519A.dat"))
+        .arg(model_path("profiles/en15302/SUIC519A.dat"))
         .args(["--gauge", "1435.16", "--diameters", "920,920"])
         .output()
         .unwrap();
@@ -36,7 +31,7 @@ fn conicity_e1_matches_en15302_reference() {
         .collect();
     assert_eq!(rows.len(), 20);
     assert!((rows[0].0 - 0.5).abs() < 1e-9 && (rows[19].0 - 10.0).abs() < 1e-9);
-    let reference = std::fs::read_to_string(E1).unwrap();
+    let reference = std::fs::read_to_string(reference_path("conicity/ben_E1.dat")).unwrap();
     let mut compared = 0;
     for l in reference.lines().filter(|l| !l.trim().is_empty()) {
         let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
@@ -56,9 +51,9 @@ fn conicity_writes_file_and_reports_bad_input() {
     let out_csv = dir.join("c.csv");
     let st = Command::new(env!("CARGO_BIN_EXE_umsim"))
         .args(["conicity", "--wheel"])
-        .arg(format!("{PROFILES}RUIC519B.dat"))
+        .arg(model_path("profiles/en15302/RUIC519B.dat"))
         .arg("--rail")
-        .arg(format!("{PROFILES}SUIC519A.dat"))
+        .arg(model_path("profiles/en15302/SUIC519A.dat"))
         .args(["--gauge", "1435.16", "-o"])
         .arg(&out_csv)
         .status()
@@ -73,7 +68,7 @@ fn conicity_writes_file_and_reports_bad_input() {
         .args(["conicity", "--wheel"])
         .arg(&bad)
         .arg("--rail")
-        .arg(format!("{PROFILES}SUIC519A.dat"))
+        .arg(model_path("profiles/en15302/SUIC519A.dat"))
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
@@ -82,12 +77,9 @@ fn conicity_writes_file_and_reports_bad_input() {
     // a rail given as wheel is refused by its extension
     let out = Command::new(env!("CARGO_BIN_EXE_umsim"))
         .args(["conicity", "--wheel"])
-        .arg(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../models/profiles/MBench_UIC60_v3.prr"
-        ))
+        .arg(model_path("profiles/MBench_UIC60_v3.prr"))
         .arg("--rail")
-        .arg(format!("{PROFILES}SUIC519A.dat"))
+        .arg(model_path("profiles/en15302/SUIC519A.dat"))
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
@@ -101,9 +93,9 @@ fn conicity_writes_file_and_reports_bad_input() {
 fn a_wheel_profile_as_the_rail_is_an_error() {
     let out = Command::new(env!("CARGO_BIN_EXE_umsim"))
         .args(["conicity", "--wheel"])
-        .arg(format!("{PROFILES}RUIC519A.dat"))
+        .arg(model_path("profiles/en15302/RUIC519A.dat"))
         .arg("--rail")
-        .arg(format!("{PROFILES}RUIC519A.dat"))
+        .arg(model_path("profiles/en15302/RUIC519A.dat"))
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -2,6 +2,7 @@
 //! test binary.
 
 mod bench_cli;
+mod common;
 mod conicity_cli;
 mod creep_cli;
 mod plot_cli;

@@ -1,8 +1,8 @@
 //! `umsim plot` end to end: SVG and PNG files from a small results CSV, column
 //! wildcards, x ranges, gaps, and the error messages.
 
+use crate::common::umsim;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 const HEADER: &str = "time,s[m],body.y[m],Bogie1.WS1.contact.L.Y/Q [-],\
                       Bogie1.WS2.contact.L.Y/Q [-],Bogie1.WS1.contact.R.Y/Q [-],\
@@ -27,13 +27,6 @@ fn results(dir: &Path) -> PathBuf {
     let path = dir.join("results.csv");
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn umsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_umsim"))
-        .args(args)
-        .output()
-        .expect("umsim runs")
 }
 
 fn ok(args: &[&str]) {

@@ -1,45 +1,15 @@
 //! `umsim run` end to end: output file layout, summary, and the errors a user
 //! meets (missing file, unknown parameter, a simulation that blows up).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::{text, umsim};
+use railmbs_testkit::{Table, repo_path};
+use std::path::Path;
+use std::process::Command;
 
-const UMSIM: &str = env!("CARGO_BIN_EXE_umsim");
-
-/// The repository root (the bundled models live in `models/`).
-fn root() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
-}
-
-fn umsim(args: &[&str]) -> Output {
-    Command::new(UMSIM)
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("umsim starts")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Header and rows of a CSV output file.
+/// Header (joined by commas) and rows of a CSV output file.
 fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
-    let content = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let mut lines = content.lines();
-    let header = lines.next().expect("a header line").to_string();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|x| {
-                    x.parse::<f64>()
-                        .unwrap_or_else(|e| panic!("{x:?} in {l:?}: {e}"))
-                })
-                .collect()
-        })
-        .collect();
-    (header, rows)
+    let table = Table::read(path);
+    (table.header.join(","), table.rows)
 }
 
 #[test]
@@ -99,7 +69,7 @@ fn missing_scenario_file_is_named_in_the_error() {
 #[test]
 fn unknown_scenario_parameter_is_named_with_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let model = root().join("models/mechanisms/chain3.ron");
+    let model = repo_path("models/mechanisms/chain3.ron");
     let scenario = dir.path().join("bad_parameter.ron");
     std::fs::write(
         &scenario,
@@ -223,7 +193,7 @@ fn symbolic_engine_runs_or_says_why_not() {
 #[test]
 fn output_over_an_input_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let models = root().join("models");
+    let models = repo_path("models");
     let model = std::fs::read_to_string(models.join("mechanisms/chain3.ron")).unwrap();
     std::fs::write(dir.path().join("chain3.ron"), &model).unwrap();
     let scenario = "Scenario(model: \"chain3.ron\", end_time: 0.1, integrator: Rk4(step: 1e-3), output: (interval: 0.01))";
@@ -253,7 +223,7 @@ fn output_over_an_input_is_refused() {
 #[test]
 fn plugin_by_bare_name_and_truncated_plugins() {
     let dir = tempfile::tempdir().unwrap();
-    let models = root().join("models");
+    let models = repo_path("models");
     let built = Command::new(env!("CARGO_BIN_EXE_umgen"))
         .arg(models.join("mechanisms/chain3.ron"))
         .args(["-o", "chain3.so"])
@@ -263,7 +233,7 @@ fn plugin_by_bare_name_and_truncated_plugins() {
     assert!(built.status.success(), "{}", text(&built.stderr));
     let scenario = models.join("scenarios/chain3_rk4.ron");
     let run = |plugin: &str| {
-        Command::new(UMSIM)
+        Command::new(env!("CARGO_BIN_EXE_umsim"))
             .arg("run")
             .arg(&scenario)
             .args(["--plugin", plugin, "--quiet", "-o", "out.csv"])

@@ -1,26 +1,13 @@
 //! Every bundled model and scenario file loads without errors.
 
 use railmbs_models::*;
-use std::path::{Path, PathBuf};
-
-fn ron_files(folder: &str) -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map(|rd| {
-            rd.filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-                .collect()
-        })
-        .unwrap_or_default();
-    files.sort();
-    files
-}
+use railmbs_testkit::model_files;
 
 #[test]
 fn bundled_models_load() {
     let mut problems = Vec::new();
     for folder in ["mechanisms", "mechanisms/subsystems", "vehicles"] {
-        for path in ron_files(folder) {
+        for path in model_files(folder) {
             match load_model(&path) {
                 Ok(m) => {
                     let p = m.default_parameter_values();
@@ -36,7 +23,7 @@ fn bundled_models_load() {
 #[test]
 fn bundled_scenarios_resolve() {
     let mut problems = Vec::new();
-    for path in ron_files("scenarios") {
+    for path in model_files("scenarios") {
         let resolve = |sc: &Scenario, model: &Model| {
             let p = sc.parameter_values(model)?;
             sc.initial_state(model, &p).map(|_| ())

@@ -292,9 +292,11 @@ fn load_model_reads_a_file() {
 
 /// `free_wheelset.ron` with `creep` set to `law` (profiles by absolute path).
 fn wheelset_with_creep(law: &str) -> Result<Model, ModelErrors> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(dir.join("vehicles/free_wheelset.ron")).unwrap();
-    let profiles = dir.join("profiles").display().to_string();
+    let file = railmbs_testkit::model_path("vehicles/free_wheelset.ron");
+    let text = std::fs::read_to_string(file).unwrap();
+    let profiles = railmbs_testkit::model_path("profiles")
+        .display()
+        .to_string();
     let text = text
         .replace("\"../profiles", &format!("\"{profiles}"))
         .replace(

@@ -4,13 +4,12 @@
 
 use crate::common::{S1002_PRW, UIC60_BAN};
 use railmbs_models::*;
+use railmbs_testkit::model_path;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn example(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("mechanisms/subsystems")
-        .join(name)
+    model_path("mechanisms/subsystems").join(name)
 }
 
 fn vehicle() -> Model {
@@ -1147,7 +1146,7 @@ fn edge_cases_of_overrides_and_parents() {
 
 #[test]
 fn cut_joints_of_subsystems_get_long_names() {
-    let fourbar = Path::new(env!("CARGO_MANIFEST_DIR")).join("mechanisms/fourbar.ron");
+    let fourbar = model_path("mechanisms/fourbar.ron");
     let original = load_model(&fourbar).unwrap();
     assert!(!original.cut_joints.is_empty());
     let text = format!(

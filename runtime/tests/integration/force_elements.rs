@@ -6,21 +6,12 @@
 //! (an independent computation), from closed-form solutions, or from runs with
 //! the finite-difference Jacobian, never from the analytic Jacobian under test.
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::ops::ControlFlow;
-use std::path::Path;
 
 use nalgebra::DMatrix;
-use railmbs_models::Model;
 use railmbs_runtime::MechanicalSystem;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-
-/// Relative difference in the max norm.
-fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (a - b).amax() / b.amax().max(1e-300)
-}
 
 /// Two bodies moving by translations only (Γ constant, no rotation), joined by
 /// springs at points off their centres and a 6×6 element with coupling terms:
@@ -58,8 +49,8 @@ Model(
 #[test]
 fn assembled_jacobian_equals_central_differences_for_translating_bodies() {
     let model = parse(TRANSLATING);
-    let (mut sys, q, v) = system(&model, &[]);
-    let (dq, dv) = analytic(&mut sys, &q, &v);
+    let (mut sys, q, v) = numeric_system(&model, &[]);
+    let (dq, dv) = analytic_jacobians(&mut sys, &q, &v);
     let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
     let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // Central differences with h = 1e-6 of forces ~1e3 N: truncation
@@ -98,9 +89,9 @@ Model(
 #[test]
 fn assembled_jacobian_is_exact_for_rotating_bodies_at_zero_force() {
     let model = parse(ROTATING);
-    let (mut sys, q, v) = system(&model, &[]);
+    let (mut sys, q, v) = numeric_system(&model, &[]);
     assert!(v.iter().all(|x| *x == 0.0));
-    let (dq, dv) = analytic(&mut sys, &q, &v);
+    let (dq, dv) = analytic_jacobians(&mut sys, &q, &v);
     let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
     let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // Same difference accuracy as above; rotations enter through sin/cos of
@@ -115,25 +106,17 @@ fn systems_without_force_elements_fall_back_to_differences() {
         r#"Model(name: "p", bodies: [Body(name: "a", mass: 1, inertia: (ixx: 1, iyy: 1, izz: 1),
             joint: Revolute(parent: "ground", axis: X, to_com: (0, 0, -1)))])"#,
     );
-    let (mut sys, q, v) = system(&model, &[]);
+    let (mut sys, q, v) = numeric_system(&model, &[]);
     let mut dq = DMatrix::zeros(1, 1);
     let mut dv = DMatrix::zeros(1, 1);
     assert!(!sys.force_jacobian(0.0, &q, &v, &mut dq, &mut dv).unwrap());
 }
 
-fn spring_mass() -> Model {
-    let p = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/mechanisms/spring_mass.ron"
-    );
-    railmbs_models::load_model(Path::new(p)).unwrap_or_else(|e| panic!("{e}"))
-}
-
 #[test]
 fn park_with_the_analytic_jacobian_matches_differences_with_fewer_evaluations() {
-    let model = spring_mass();
+    let model = mechanism("spring_mass");
     let run = |kind: JacobianKind| {
-        let (mut sys, q0, v0) = system(&model, &[]);
+        let (mut sys, q0, v0) = numeric_system(&model, &[]);
         let settings = ParkSettings {
             jacobian: kind,
             ..ParkSettings::with_tolerances(1e-8, 1e-10)

@@ -6,37 +6,13 @@
 //! the damped oscillator's decrement (Pogorelov 2005, Table 1), force values computed
 //! by hand, and the local Jacobians against central differences.
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::f64::consts::PI;
-use std::ops::ControlFlow;
-use std::path::Path;
 
 use nalgebra::{DMatrix, DVector};
 use railmbs_runtime::forces::contact_stiffness_damping;
-use railmbs_runtime::integrate::{IntegrationStats, JacobianKind, ParkSettings, integrate_park};
+use railmbs_runtime::integrate::{JacobianKind, ParkSettings};
 use railmbs_runtime::{MechanicalSystem, ModelSystem, Parts};
-
-/// An accepted state (t, q, v).
-type State = (f64, Vec<f64>, Vec<f64>);
-
-/// Runs Park and returns the stats and the accepted states.
-fn run(
-    sys: &mut ModelSystem,
-    q0: &[f64],
-    v0: &[f64],
-    t_end: f64,
-    settings: &ParkSettings,
-) -> (IntegrationStats, Vec<State>) {
-    let mut states = Vec::new();
-    let st = integrate_park(sys, settings, 0.0, q0, v0, t_end, |t, q, v, _| {
-        states.push((t, q.to_vec(), v.to_vec()));
-        ControlFlow::Continue(())
-    })
-    .unwrap_or_else(|e| panic!("{e}"));
-    (st, states)
-}
 
 fn settings(rtol: f64, atol: f64, max_step: f64) -> ParkSettings {
     ParkSettings {
@@ -85,12 +61,13 @@ fn ball_rebounds_with_the_restitution_of_the_linear_contact() {
     for zeta in [0.05, 0.1, 0.3] {
         // 50 Hz contact for the 1 kg ball.
         let (c, d) = contact_stiffness_damping(50.0, zeta, 1.0).unwrap();
-        let (mut sys, q0, v0) = system(&model, &[("c", c.to_string()), ("d", d.to_string())]);
+        let (mut sys, q0, v0) =
+            numeric_system(&model, &[("c", &c.to_string()), ("d", &d.to_string())]);
         // The dashpot makes the acceleration jump by d·v0/m at touchdown; the
         // error test resolves the jump with steps ~tol/Δa, and velocities
         // from position differences carry rounding ~1e-16·|q|/h, so the
         // tolerance cannot go much below 1e-7 here.
-        let (st, _) = run(&mut sys, &q0, &v0, 0.05, &settings(1e-7, 1e-7, 1e-3));
+        let (_, st) = run_park(&mut sys, &settings(1e-7, 1e-7, 1e-3), &q0, &v0, 0.05);
         let e = st.v[0] / 1.0;
         let expected = restitution_without_adhesion(zeta);
         let classical = (-PI * zeta / (1.0 - zeta * zeta).sqrt()).exp();
@@ -151,8 +128,8 @@ fn block_sticks_on_an_incline_below_the_static_friction_angle() {
     let model = parse(BLOCK);
     // tan α = 0.25 < μ0 = 0.3.
     let alpha = 0.25f64.atan();
-    let (mut sys, q0, v0) = system(&model, &[("alpha", alpha.to_string())]);
-    let (st, states) = run(&mut sys, &q0, &v0, 20.0, &settings(1e-7, 1e-9, 0.05));
+    let (mut sys, q0, v0) = numeric_system(&model, &[("alpha", &alpha.to_string())]);
+    let (states, st) = run_park(&mut sys, &settings(1e-7, 1e-9, 0.05), &q0, &v0, 20.0);
     // The anchor springs carry m g sin α: deflection m g sin α/(4 c_t) = 2.4e-5 m.
     let expected = 10.0 * 9.81 * alpha.sin() / (4.0 * 2.5e5);
     let x_at = |t: f64| {
@@ -189,8 +166,8 @@ fn block_slides_above_the_friction_angle_with_the_coulomb_acceleration() {
     let model = parse(BLOCK);
     // tan α = 0.4 > μ0 = 0.3.
     let alpha = 0.4f64.atan();
-    let (mut sys, q0, v0) = system(&model, &[("alpha", alpha.to_string())]);
-    let (_, states) = run(&mut sys, &q0, &v0, 2.0, &settings(1e-8, 1e-9, 0.01));
+    let (mut sys, q0, v0) = numeric_system(&model, &[("alpha", &alpha.to_string())]);
+    let (states, _) = run_park(&mut sys, &settings(1e-8, 1e-9, 0.01), &q0, &v0, 2.0);
     let (g, m, mu) = (9.81f64, 10.0f64, 0.2f64);
     let accel = g * (alpha.sin() - mu * alpha.cos());
     let at = |t: f64| states.iter().find(|(ts, ..)| *ts >= t - 1e-12).unwrap();
@@ -240,8 +217,8 @@ Model(
 #[test]
 fn coulomb_element_holds_a_load_below_its_limit_without_drift() {
     let model = parse(HANGING);
-    let (mut sys, q0, v0) = system(&model, &[]);
-    let (st, states) = run(&mut sys, &q0, &v0, 100.0, &settings(1e-8, 1e-9, 0.5));
+    let (mut sys, q0, v0) = numeric_system(&model, &[]);
+    let (states, st) = run_park(&mut sys, &settings(1e-8, 1e-9, 0.5), &q0, &v0, 100.0);
     let z_at = |t: f64| states.iter().find(|(ts, ..)| *ts >= t).unwrap().1[0];
     // Held (m g = 9.81 N < F0 = 20 N): no motion at all over 95 s.
     assert!(
@@ -263,11 +240,11 @@ fn coulomb_element_holds_a_load_below_its_limit_without_drift() {
 fn coulomb_element_slides_above_its_limit_at_the_sliding_force() {
     let model = parse(HANGING);
     // m = 3 kg: m g = 29.4 N > F0 = 20 N; sliding at Fs = 15 N.
-    let (mut sys, q0, v0) = system(&model, &[("m", "3".into())]);
+    let (mut sys, q0, v0) = numeric_system(&model, &[("m", "3")]);
     // Breakaway drops the force from F0 to Fs at a step boundary: a jump of
     // the acceleration the error test resolves down to steps ~tol/Δa, so the
     // tolerance stays ≥ 1e-7 (see the ball test).
-    let (_, states) = run(&mut sys, &q0, &v0, 1.0, &settings(1e-7, 1e-7, 0.01));
+    let (states, _) = run_park(&mut sys, &settings(1e-7, 1e-7, 0.01), &q0, &v0, 1.0);
     let at = |t: f64| states.iter().find(|(ts, ..)| *ts >= t - 1e-12).unwrap();
     let (t1, _, v1) = at(0.5);
     let (t2, _, v2) = at(1.0);
@@ -283,11 +260,7 @@ fn coulomb_element_slides_above_its_limit_at_the_sliding_force() {
 
 #[test]
 fn damped_oscillator_half_period_ratio_reproduces_table_1() {
-    let p = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/mechanisms/spring_mass.ron"
-    );
-    let model = railmbs_models::load_model(Path::new(p)).unwrap();
+    let model = mechanism("spring_mass");
     // Pogorelov (2005), Table 1: D after half a period for ζ.
     let table = [
         (0.1, 0.729),
@@ -300,10 +273,10 @@ fn damped_oscillator_half_period_ratio_reproduces_table_1() {
         // No gravity, released from rest 0.1 m beyond the free length L0 = 1:
         // x(t) = x0 e^{−σt}(cos ω_d t + σ/ω_d sin ω_d t), so x(π/ω_d) = −D x0 exactly.
         let (mut sys, mut q0, v0) =
-            system(&model, &[("zeta", zeta.to_string()), ("g", "0".into())]);
+            numeric_system(&model, &[("zeta", &zeta.to_string()), ("g", "0")]);
         q0[0] = -1.1;
         let w_d = 10.0 * (1.0f64 - zeta * zeta).sqrt();
-        let (st, _) = run(&mut sys, &q0, &v0, PI / w_d, &settings(1e-9, 1e-9, 0.01));
+        let (_, st) = run_park(&mut sys, &settings(1e-9, 1e-9, 0.01), &q0, &v0, PI / w_d);
         let d = (st.q[0] + 1.0) / 0.1;
         let exact = (-PI * zeta / (1.0 - zeta * zeta).sqrt()).exp();
         // Table 1 is printed to three decimals.
@@ -353,7 +326,7 @@ fn outputs(sys: &mut ModelSystem, q: &[f64], v: &[f64]) -> Vec<f64> {
 #[test]
 fn element_forces_match_hand_computed_values() {
     let model = parse(PAIR);
-    let (mut sys, ..) = system(&model, &[]);
+    let (mut sys, ..) = numeric_system(&model, &[]);
     // Tabulated: deflection u = x − 0.5.
     for (x, v, f) in [
         (0.5, 0.0, 0.0),       // dead band
@@ -390,7 +363,7 @@ fn element_forces_match_hand_computed_values() {
     // Coulomb: the state is set where the system is accepted. Stick at
     // x = 0.6 with f0 = 0 (accepted at rest), then F = 1000 (x − 0.6) up to
     // the limit 50 N.
-    let (mut sys, ..) = system(&model, &[]);
+    let (mut sys, ..) = numeric_system(&model, &[]);
     sys.accept_step(0.0, &[0.6, 0.0, 0.0], &[0.0, 0.0, 0.0])
         .unwrap();
     let out = outputs(&mut sys, &[0.63, 0.0, 0.0], &[0.0, 0.0, 0.0]);
@@ -418,7 +391,7 @@ fn element_forces_match_hand_computed_values() {
     // capacity), loading to u = 0.01: sliding branch F = c1 a/(c1 + a) u with
     // a = c2(1 + μ) = 1250: F = 3000·1250/4250·0.01 = 8.8235… N,
     // x2 = c1 u/(c1 + a) = 0.0070588 m.
-    let (mut sys, ..) = system(&model, &[]);
+    let (mut sys, ..) = numeric_system(&model, &[]);
     let out = outputs(&mut sys, &[0.51, 0.0, 0.0], &[0.0, 0.0, 0.0]);
     let f = 3000.0 * 1250.0 / 4250.0 * 0.01;
     assert!((out[9] - f).abs() < 1e-9, "{out:?}");
@@ -433,7 +406,7 @@ fn load_dependent_friction_loop_energy_is_independent_of_frequency() {
     // integrator would).
     let (c1, c2, mu, a) = (3000.0f64, 1000.0f64, 0.25f64, 0.01f64);
     let loop_energy = |freq: f64| {
-        let (mut sys, ..) = system(&model, &[]);
+        let (mut sys, ..) = numeric_system(&model, &[]);
         let n = 4000;
         let mut w = 0.0;
         let mut prev: Option<(f64, f64)> = None;
@@ -525,7 +498,7 @@ fn new_elements_local_jacobians_equal_central_differences() {
     // Sliding (va = 0.3 m/s: tangential speed well above V_STICK) and
     // sticking (va = 0 and slow velocities: anchors stored at the accepted state).
     for va in ["0.3", "0"] {
-        let (mut sys, q, mut v) = system(&model, &[("va", va.into())]);
+        let (mut sys, q, mut v) = numeric_system(&model, &[("va", va)]);
         if va == "0" {
             v.iter_mut().for_each(|x| *x *= 1e-3);
         }
@@ -580,8 +553,8 @@ Model(
 #[test]
 fn block_on_a_moving_belt_shows_the_stick_slip_cycle() {
     let model = parse(BELT);
-    let (mut sys, q0, v0) = system(&model, &[]);
-    let (_, states) = run(&mut sys, &q0, &v0, 1.5, &settings(1e-7, 1e-7, 1e-3));
+    let (mut sys, q0, v0) = numeric_system(&model, &[]);
+    let (states, _) = run_park(&mut sys, &settings(1e-7, 1e-7, 1e-3), &q0, &v0, 1.5);
     let (m, g, k, mu0, mu, vb) = (1.0f64, 9.81f64, 1000.0f64, 0.4f64, 0.3f64, 0.1f64);
     // Sticking: the block rides with the belt until the spring force k x
     // reaches μ0 m g, at x0 = μ0 m g/k; sliding: harmonic motion about

@@ -6,9 +6,7 @@
 //! under a constant Coulomb force), which follows in closed form from the
 //! energy balance over the half cycle.
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::ops::ControlFlow;
 
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
@@ -51,7 +49,7 @@ fn closed_form_ratio(c1: f64, c2: f64, mu: f64) -> f64 {
 
 #[test]
 fn load_friction_free_vibration_decays_geometrically() {
-    let (mut sys, q0, v0) = system(&parse(MODEL), &[]);
+    let (mut sys, q0, v0) = numeric_system(&parse(MODEL), &[]);
     let settings = ParkSettings {
         max_step: 2e-5,
         jacobian: JacobianKind::Analytic,

@@ -3,14 +3,12 @@
 //! the closed-form solution of the linear third-order system, the energy
 //! balance of the damper, and its Jacobian against central differences.
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::ops::ControlFlow;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use railmbs_runtime::MechanicalSystem;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
-use railmbs_runtime::{MechanicalSystem, NumericEquations};
 
 /// A mass m on a line, tied to the ground by a spring c in series with a
 /// damper d, started with velocity v0 from the relaxed state.
@@ -55,7 +53,7 @@ fn maxwell_element_follows_the_closed_form_response() {
     let a = Matrix3::new(0.0, 1.0, 0.0, 0.0, 0.0, -c / m, 0.0, 1.0, -c / d);
     let y0 = Vector3::new(0.0, v0, 0.0);
     let model = parse(MAXWELL);
-    let (mut sys, q0, v0s) = system(&model, &[]);
+    let (mut sys, q0, v0s) = numeric_system(&model, &[]);
     assert_eq!(sys.state_names(), ["maxwell.s"]);
     assert_eq!((q0.len(), v0s.clone()), (2, vec![v0, v0]));
     // Largest deviation of (x, s) from the closed form, and steps, at a tolerance.
@@ -98,7 +96,7 @@ fn maxwell_element_dissipates_its_damper_work() {
     // carrying the spring force F = c s at the rate ẋ − ṡ = F/d.
     let (m, c, d, v0) = (1.0, 1e4, 200.0, 1.0);
     let model = parse(MAXWELL);
-    let (mut sys, q0, v0s) = system(&model, &[]);
+    let (mut sys, q0, v0s) = numeric_system(&model, &[]);
     let settings = ParkSettings {
         max_step: 2e-4,
         jacobian: JacobianKind::Analytic,
@@ -152,13 +150,13 @@ Model(
 #[test]
 fn series_element_jacobian_equals_central_differences() {
     let model = parse(SKEW);
-    let (mut sys, mut q, mut v) = system(&model, &[]);
+    let (mut sys, mut q, mut v) = numeric_system(&model, &[]);
     let n = q.len();
     assert_eq!(n, 7);
     // A loaded spring and a state rate off its equilibrium value.
     q[6] = 0.004;
     v[6] = -0.2;
-    let (dq, dv) = analytic(&mut sys, &q, &v);
+    let (dq, dv) = analytic_jacobians(&mut sys, &q, &v);
     let mut mass = DMatrix::zeros(n, n);
     let mut f = DVector::zeros(n);
     sys.dynamics(0.0, &q, &v, &mut mass, &mut f).unwrap();
@@ -174,49 +172,22 @@ fn series_element_jacobian_equals_central_differences() {
 }
 
 /// Runs the Maxwell model through a scenario (in a temporary directory) with
-/// the given integrator and returns the summary or the error text, and the
-/// output's header and rows.
-fn run_scenario_with(integrator: &str) -> (Result<(), String>, Vec<String>, Vec<Vec<f64>>) {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("maxwell.ron"), MAXWELL).unwrap();
-    let text = format!(
+/// the given integrator; returns the output or the error text.
+fn run_scenario_with(integrator: &str) -> Result<Table, String> {
+    let scenario = format!(
         "Scenario(model: \"maxwell.ron\", end_time: 0.05, integrator: {integrator},
                   output: (interval: 0.01, velocities: true, forces: [\"maxwell\"]))"
     );
-    let path = dir.path().join("run.ron");
-    std::fs::write(&path, &text).unwrap();
-    let scenario = railmbs_models::parse_scenario(&text, &path).unwrap();
-    let model = railmbs_models::load_model(&scenario.model).unwrap();
-    let out = dir.path().join("out.csv");
-    let result = railmbs_runtime::run::run_scenario(
-        &scenario,
-        &model,
-        Box::new(NumericEquations::new(&model)),
-        Some(&out),
-        |_| {},
-    );
-    let result = match result {
-        Ok(s) => s.error.map_or(Ok(()), |e| Err(e.to_string())),
-        Err(e) => Err(e.to_string()),
-    };
-    let text = std::fs::read_to_string(&out).unwrap_or_default();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .map(|h| h.split(',').map(String::from).collect())
-        .unwrap_or_default();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
-    (result, header, rows)
+    run_scenario_files(&[("maxwell.ron", MAXWELL)], &scenario)
 }
 
 #[test]
 fn scenario_writes_the_state_and_refuses_explicit_integration() {
-    let (result, header, rows) = run_scenario_with("Park(rtol: 1e-8, atol: 1e-9, max_step: 0.001)");
-    result.unwrap();
+    let table = run_scenario_with("Park(rtol: 1e-8, atol: 1e-9, max_step: 0.001)")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let rows = &table.rows;
     assert_eq!(
-        header,
+        table.header,
         [
             "time",
             "x",
@@ -232,7 +203,7 @@ fn scenario_writes_the_state_and_refuses_explicit_integration() {
         ]
     );
     assert_eq!(rows.len(), 6);
-    for r in &rows {
+    for r in rows {
         // The output force is c·s of the state column.
         assert!(
             (r[5] - 1e4 * r[2]).abs() <= 1e-9 * r[5].abs().max(1.0),
@@ -240,8 +211,9 @@ fn scenario_writes_the_state_and_refuses_explicit_integration() {
         );
         assert_eq!(r[2], r[8]);
     }
-    let (result, ..) = run_scenario_with("Rk4(step: 1e-4)");
-    let message = result.unwrap_err();
+    let Err(message) = run_scenario_with("Rk4(step: 1e-4)") else {
+        panic!("Rk4 should be refused for a model with element states");
+    };
     assert!(
         message.contains("maxwell.s") && message.contains("Park"),
         "{message}"
@@ -261,7 +233,7 @@ fn a_massless_body_is_refused_not_taken_for_a_state() {
     let model = parse(&text);
     // The model's default mass is checked when it is loaded; a scenario
     // override is not.
-    let (mut sys, q0, v0) = system(&model, &[("m", "0".into())]);
+    let (mut sys, q0, v0) = numeric_system(&model, &[("m", "0")]);
     assert!(sys.state_names().is_empty());
     let settings = ParkSettings::with_tolerances(1e-8, 1e-9);
     let e = integrate_park(&mut sys, &settings, 0.0, &q0, &v0, 0.1, |_, _, _, _| {

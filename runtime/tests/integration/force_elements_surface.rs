@@ -4,9 +4,7 @@
 //! surface gives the same forces and Jacobians as the equivalent point–plane
 //! contact; bad surfaces give clear errors.
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -37,7 +35,7 @@ Model(
 #[test]
 fn bead_in_a_bowl_swings_with_the_pendulum_period() {
     let model = parse(BOWL);
-    let (mut sys, q0, v0) = system(&model, &[]);
+    let (mut sys, q0, v0) = numeric_system(&model, &[]);
     let settings = ParkSettings {
         max_step: 1e-3,
         jacobian: JacobianKind::Analytic,
@@ -113,8 +111,8 @@ Model(
 #[test]
 fn planar_surface_equals_the_point_plane_contact() {
     let (surface, plane) = (parse(&sloped(true)), parse(&sloped(false)));
-    let (mut s1, q, v) = system(&surface, &[]);
-    let (mut s2, ..) = system(&plane, &[]);
+    let (mut s1, q, v) = numeric_system(&surface, &[]);
+    let (mut s2, ..) = numeric_system(&plane, &[]);
     let n = q.len();
     for (va, stick) in [(0.3, false), (0.0, true)] {
         let mut v = v.clone();
@@ -143,18 +141,18 @@ fn planar_surface_equals_the_point_plane_contact() {
 #[test]
 fn bad_surfaces_are_refused_with_the_element_named() {
     let unknown = BOWL.replace("(x^2 + y^2)/(2*R)", "z^2");
-    let e = try_parse(&unknown).unwrap_err();
+    let e = try_parse(&unknown).unwrap_err().to_string();
     assert!(
         e.contains("bowl") && e.contains("surface") && e.contains("\"z\""),
         "{e}"
     );
     let with_normal = BOWL.replace("surface:", "normal: (0, 1, 1), surface:");
-    let e = try_parse(&with_normal).unwrap_err();
+    let e = try_parse(&with_normal).unwrap_err().to_string();
     assert!(e.contains("normal"), "{e}");
     // A surface undefined under the point stops the evaluation with the place.
     let domain = BOWL.replace("(x^2 + y^2)/(2*R)", "sqrt(1e-4 - x^2)");
     let model = parse(&domain);
-    let (mut sys, mut q, v) = system(&model, &[]);
+    let (mut sys, mut q, v) = numeric_system(&model, &[]);
     q[0] = 0.02;
     let n = q.len();
     let e = sys
@@ -172,7 +170,7 @@ fn bad_surfaces_are_refused_with_the_element_named() {
     // the ridge of the V-shaped surface z = 0.1|x| is pushed straight up.
     let kink = BOWL.replace("(x^2 + y^2)/(2*R)", "0.1*abs(x)");
     let model = parse(&kink);
-    let (mut sys, mut q, v) = system(&model, &[]);
+    let (mut sys, mut q, v) = numeric_system(&model, &[]);
     q[0] = 0.0;
     q[2] = -1e-4;
     let mut f = DVector::zeros(n);

@@ -4,10 +4,8 @@
 //! reproduced exactly inside the table (the three-point slope is exact for
 //! them), and the element's Jacobian against central differences.
 
-use crate::common;
-
-use common::*;
 use railmbs_runtime::ModelSystem;
+use railmbs_testkit::*;
 
 /// One translating body on a tabulated element along x (x0 = 0.5: the
 /// deflection is the coordinate).
@@ -33,7 +31,7 @@ Model(
 
 /// The system of a model text (see [`model`]) and its initial state.
 fn system_of(text: &str) -> (ModelSystem, Vec<f64>, Vec<f64>) {
-    system(&parse(text), &[])
+    numeric_system(&parse(text), &[])
 }
 
 /// The element's characteristic f(u) (N) at deflection u, read from its
@@ -122,7 +120,7 @@ fn spline_bump_stop_passes_the_rows_without_overshoot() {
 fn spline_element_jacobian_equals_central_differences() {
     let (mut sys, mut q, v) = system_of(&model(STOP_TABLE, "Spline"));
     q[0] = 0.5 + 0.0237; // inside a cubic segment
-    let (dq, _) = analytic(&mut sys, &q, &v);
+    let (dq, _) = analytic_jacobians(&mut sys, &q, &v);
     let fq = central_difference(&mut sys, &q, &v, false, 1e-7);
     // Forces ~3e4 N, h = 1e-7 m: rounding ε·3e4/h ≈ 7e-5 N/m, truncation
     // f'''h²/6 ≈ negligible: 1e-7 of the largest entry (~4e6 N/m).

@@ -4,12 +4,9 @@
 //! at φ(0) = φ0 + A is φ0 + A e^(−σt) (cos ω_d t + (σ/ω_d) sin ω_d t) with
 //! σ = d/(2J) and ω_d = √(c/J − σ²).
 
-use crate::common;
-
-use common::*;
+use railmbs_testkit::*;
 use std::ops::ControlFlow;
 
-use nalgebra::DMatrix;
 use railmbs_runtime::Parts;
 use railmbs_runtime::integrate::{JacobianKind, ParkSettings, integrate_park};
 
@@ -41,7 +38,7 @@ fn torsional_oscillator_matches_the_damped_solution() {
     let wd = (c / j - sigma * sigma).sqrt();
     let exact =
         |t: f64| phi0 + a * (-sigma * t).exp() * ((wd * t).cos() + sigma / wd * (wd * t).sin());
-    let (mut sys, q0, v0) = system(&parse(DISC), &[]);
+    let (mut sys, q0, v0) = numeric_system(&parse(DISC), &[]);
     let settings = ParkSettings {
         jacobian: JacobianKind::Analytic,
         ..ParkSettings::with_tolerances(1e-8, 1e-10)
@@ -85,7 +82,7 @@ fn torsional_oscillator_matches_the_damped_solution() {
 
 #[test]
 fn outputs_are_moment_angle_rate_energy_and_power() {
-    let (mut sys, ..) = system(&parse(DISC), &[]);
+    let (mut sys, ..) = numeric_system(&parse(DISC), &[]);
     let (q, v) = ([0.35], [1.5]);
     sys.evaluate(0.0, &q, &v, Parts::KINEMATICS).unwrap();
     let mut out = Vec::new();
@@ -126,15 +123,10 @@ Model(
 )
 "#;
 
-/// Largest entry of a − b relative to the largest of b.
-fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (a - b).amax() / b.amax().max(1e-300)
-}
-
 #[test]
 fn assembled_jacobian_equals_central_differences() {
-    let (mut sys, q, v) = system(&parse(PAIR), &[]);
-    let (dq, dv) = analytic(&mut sys, &q, &v);
+    let (mut sys, q, v) = numeric_system(&parse(PAIR), &[]);
+    let (dq, dv) = analytic_jacobians(&mut sys, &q, &v);
     let fq = central_difference(&mut sys, &q, &v, false, 1e-6);
     let fv = central_difference(&mut sys, &q, &v, true, 1e-6);
     // The moment is linear in the angles (φ = qb − qa exactly, |φ| < π) and

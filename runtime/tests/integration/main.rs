@@ -1,7 +1,6 @@
 //! The integration tests of `runtime`, one module per topic, linked into one
 //! test binary.
 
-mod common;
 mod force_elements;
 mod force_elements_contact;
 mod force_elements_decay;

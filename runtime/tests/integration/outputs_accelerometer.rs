@@ -4,45 +4,14 @@
 //! oscillator, and the lateral acceleration v²/R of a body carried round a
 //! curve by its track-following frame.
 
-use railmbs_runtime::NumericEquations;
-use railmbs_runtime::run::run_scenario;
+use railmbs_testkit::{Table, run_scenario_files};
 
-/// Runs `scenario` (text) with `model` (text) written beside it; returns the
-/// header and rows of the output.
-fn run(model: &str, scenario: &str, extra: &[(&str, &str)]) -> (Vec<String>, Vec<Vec<f64>>) {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("model.ron"), model).unwrap();
-    for (name, text) in extra {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    let path = dir.path().join("run.ron");
-    std::fs::write(&path, scenario).unwrap();
-    let sc = railmbs_models::load_scenario(&path).unwrap_or_else(|e| panic!("{e}"));
-    let m = railmbs_models::load_model(&sc.model).unwrap_or_else(|e| panic!("{e}"));
-    let out = dir.path().join("out.csv");
-    let summary = run_scenario(
-        &sc,
-        &m,
-        Box::new(NumericEquations::new(&m)),
-        Some(&out),
-        |_| {},
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    assert!(summary.error.is_none(), "{:?}", summary.error);
-    let text = std::fs::read_to_string(&out).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header
-        .iter()
-        .position(|h| h == name)
-        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+/// Runs `scenario` (text) with `model` (text, as `model.ron`) and the
+/// `extra` files written beside it; returns the output.
+fn run(model: &str, scenario: &str, extra: &[(&str, &str)]) -> Table {
+    let mut files = vec![("model.ron", model)];
+    files.extend_from_slice(extra);
+    run_scenario_files(&files, scenario).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -74,9 +43,9 @@ Scenario(
     }),
 )
 "#;
-    let (h, rows) = run(model, scenario, &[]);
+    let table = run(model, scenario, &[]);
     assert_eq!(
-        h[h.len() - 9..],
+        table.header[table.header.len() - 9..],
         [
             "rim.ax[m/s2]",
             "rim.ay[m/s2]",
@@ -90,12 +59,12 @@ Scenario(
         ]
     );
     let (rim, axis, m, x) = (
-        col(&h, "rim.ax[m/s2]"),
-        col(&h, "axis.ax[m/s2]"),
-        col(&h, "m.ax[m/s2]"),
-        col(&h, "x"),
+        table.index("rim.ax[m/s2]"),
+        table.index("axis.ax[m/s2]"),
+        table.index("m.ax[m/s2]"),
+        table.index("x"),
     );
-    for r in &rows {
+    for r in &table.rows {
         // Centripetal ω² r towards the axis, in the disc's own frame: the
         // central difference over ε = 1e-5 s has truncation ω²ε²·|a|/6 ≈ 1e-10.
         assert!((r[rim] + 4.0 * 0.5).abs() < 1e-8, "{r:?}");
@@ -145,9 +114,9 @@ Scenario(
     output: (interval: 0.5, accelerometers: { "c": ("box", (0, 0, 0)), "front": ("box", (3, 0, 0)) }),
 )
 "#;
-    let (h, rows) = run(model, scenario, &[("track.ron", track)]);
-    let (c, f) = (col(&h, "c.ax[m/s2]"), col(&h, "front.ax[m/s2]"));
-    for r in &rows {
+    let table = run(model, scenario, &[("track.ron", track)]);
+    let (c, f) = (table.index("c.ax[m/s2]"), table.index("front.ax[m/s2]"));
+    for r in &table.rows {
         // Turning left: the acceleration points to the left, +y.
         assert!((r[c + 1] - 0.8).abs() < 1e-6, "{r:?}");
         assert!(r[c].abs() < 1e-6 && r[c + 2].abs() < 1e-6, "{r:?}");

@@ -1,12 +1,10 @@
 //! Integrated motion of the bundled mechanisms against analytic solutions and
 //! conservation laws (issue 2's physics tests).
 
-use crate::common;
-
-use common::*;
 use nalgebra::{Matrix3, Vector3};
 use railmbs_runtime::integrate::ParkSettings;
 use railmbs_runtime::{MechanicalSystem, Parts};
+use railmbs_testkit::*;
 
 /// Complete elliptic integral of the first kind K(k) by the arithmetic–geometric mean.
 fn elliptic_k(k: f64) -> f64 {

@@ -1,7 +1,6 @@
 //! The integration tests of `tests`, one module per topic, linked into one
 //! test binary.
 
-mod common;
 mod dynamics;
 mod equations;
 mod plugins;

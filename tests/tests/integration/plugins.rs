@@ -2,22 +2,16 @@
 //! from another model, for another ABI version, or is not a plugin at all; and a
 //! simulation gives the same trajectory with either engine.
 
-use crate::common;
-
-use common::*;
 use railmbs_runtime::integrate::ParkSettings;
 use railmbs_runtime::{ModelSystem, NumericEquations, Plugin, PluginError};
+use railmbs_testkit::*;
 use std::path::PathBuf;
-
-fn cache() -> PathBuf {
-    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("railmbs-plugins")
-}
 
 fn build(model: &railmbs_models::Model) -> PathBuf {
     railmbs_codegen::build_plugin(
         model,
         &railmbs_codegen::GenerateOptions::new(),
-        Some(cache()),
+        Some(plugin_cache_dir()),
     )
     .unwrap_or_else(|e| panic!("{e}"))
     .path
@@ -66,7 +60,7 @@ fn plugin_of_another_abi_version_is_refused() {
     );
     let path = railmbs_build_support::build_plugin(
         &other,
-        &railmbs_build_support::BuildOptions::new(abi + 100).with_cache_dir(cache()),
+        &railmbs_build_support::BuildOptions::new(abi + 100).with_cache_dir(plugin_cache_dir()),
     )
     .unwrap()
     .path;
@@ -87,7 +81,7 @@ fn a_file_that_is_not_a_plugin_is_refused() {
     // A real shared library without the plugin's symbols.
     let lib = railmbs_build_support::build_plugin(
         "#[no_mangle] pub extern \"C\" fn something_else() -> i32 { 1 }",
-        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(cache()),
+        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(plugin_cache_dir()),
     )
     .unwrap();
     let err = Plugin::load_for(&lib.path, &model).unwrap_err();
@@ -142,7 +136,7 @@ fn a_plugin_for_cpu_features_this_machine_lacks_is_refused() {
     let lib = railmbs_build_support::build_plugin(
         "#[no_mangle] pub extern \"C\" fn railmbs_target_features() -> *const u8 { \
          b\"avx,no-such-feature\\0\".as_ptr() }",
-        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(cache()),
+        &railmbs_build_support::BuildOptions::new(1).with_cache_dir(plugin_cache_dir()),
     )
     .unwrap();
     let err = Plugin::load_for(&lib.path, &model).unwrap_err();
@@ -176,7 +170,7 @@ fn native_and_portable_plugins_report_their_cpu_features_and_agree() {
     let native = build(&model);
     let mut opts = railmbs_codegen::GenerateOptions::new();
     opts.portable = true;
-    let portable = railmbs_codegen::build_plugin(&model, &opts, Some(cache()))
+    let portable = railmbs_codegen::build_plugin(&model, &opts, Some(plugin_cache_dir()))
         .unwrap()
         .path;
     assert_ne!(native, portable);
@@ -219,7 +213,7 @@ fn fixed_parameters_are_folded_and_other_values_refused() {
     let model = mechanism("pendulum");
     let mut opts = railmbs_codegen::GenerateOptions::new();
     opts.fixed = vec!["l".into(), "r".into()];
-    let built = railmbs_codegen::build_plugin(&model, &opts, Some(cache())).unwrap();
+    let built = railmbs_codegen::build_plugin(&model, &opts, Some(plugin_cache_dir())).unwrap();
     let plugin = Plugin::load_for(&built.path, &model).unwrap();
     let mut eq = railmbs_runtime::PluginEquations::new(plugin);
     let mut params = model.default_parameter_values();
@@ -234,7 +228,7 @@ fn fixed_parameters_are_folded_and_other_values_refused() {
             fixed: vec!["nope".into()],
             ..opts
         },
-        Some(cache()),
+        Some(plugin_cache_dir()),
     )
     .unwrap_err()
     .to_string();

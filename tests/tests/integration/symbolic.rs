@@ -2,11 +2,9 @@
 //! numeric-iterative engine on random states (relative 1e-12 on M, k, Q_g,
 //! kinematics, Jacobians, constraints), and the same trajectories.
 
-use crate::common;
-
-use common::*;
 use nalgebra::DMatrix;
 use railmbs_runtime::{Equations, Evaluation, Parts};
+use railmbs_testkit::*;
 
 fn close(a: &DMatrix<f64>, b: &DMatrix<f64>, what: &str, model: &str) {
     close_scaled(a, b, b.abs().max().max(1e-300), what, model);
@@ -29,14 +27,14 @@ fn symbolic_equals_numeric_on_every_bundled_model() {
         let mut sym = symbolic_engine(&model);
         let mut en = Evaluation::for_equations(&num);
         let mut es = Evaluation::for_equations(&sym);
-        let mut rng = Rng::new(42);
+        let mut rng = seeded_rng(42);
         for _ in 0..100 {
             let n = num.dof();
-            let t = rng.uniform(0.0, 3.0);
-            let q = rng.vec(n, -2.0, 2.0);
-            let v = rng.vec(n, -3.0, 3.0);
+            let t = rng.random_range(0.0..3.0);
+            let q = uniform_vec(&mut rng, n, -2.0, 2.0);
+            let v = uniform_vec(&mut rng, n, -3.0, 3.0);
             // Track-following frames: a random pose, rates and accelerations.
-            let u = rng.vec(3 * num.input_count(), -2.0, 2.0);
+            let u = uniform_vec(&mut rng, 3 * num.input_count(), -2.0, 2.0);
             if !u.is_empty() {
                 num.set_inputs(&u).unwrap();
                 sym.set_inputs(&u).unwrap();

@@ -3,14 +3,12 @@
 //! constant velocity in SC0, with either engine; and the engines agree with
 //! inputs set.
 
-use crate::common;
-
-use common::*;
 use railmbs_runtime::integrate::ParkSettings;
 use railmbs_runtime::{
     DrivenEquations, Equations, Evaluation, InputProvider, ModelSystem, NumericEquations, Parts,
     SimError,
 };
+use railmbs_testkit::*;
 
 /// A frame running at speed V on a circle of radius R (left-hand curve),
 /// with roll φ(t) = a sin(w t) and pitch θ(t) = b sin(w t): analytic pose,
@@ -125,13 +123,13 @@ fn symbolic_equals_numeric_with_inputs() {
     let mut sym = symbolic_engine(&model);
     let mut en = Evaluation::for_equations(&num);
     let mut es = Evaluation::for_equations(&sym);
-    let mut rng = Rng::new(17);
+    let mut rng = seeded_rng(17);
     for _ in 0..100 {
-        let u = rng.vec(18, -2.0, 2.0);
+        let u = uniform_vec(&mut rng, 18, -2.0, 2.0);
         num.set_inputs(&u).unwrap();
         sym.set_inputs(&u).unwrap();
-        let q = rng.vec(6, -1.0, 1.0);
-        let v = rng.vec(6, -2.0, 2.0);
+        let q = uniform_vec(&mut rng, 6, -1.0, 1.0);
+        let v = uniform_vec(&mut rng, 6, -2.0, 2.0);
         num.evaluate(0.3, &q, &v, Parts::ALL, &mut en).unwrap();
         sym.evaluate(0.3, &q, &v, Parts::ALL, &mut es).unwrap();
         let scale = en.mass.abs().max();

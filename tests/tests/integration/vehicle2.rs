@@ -2,11 +2,9 @@
 //! suspension, `models/vehicles/vehicle2.ron`) on track case 3: quick
 //! physics checks on the first half second, before the lateral sinusoid.
 
-use crate::common;
-
-use common::*;
 use railmbs_models::{Model, Scenario};
 use railmbs_runtime::NumericEquations;
+use railmbs_testkit::*;
 
 /// The bundled scenario shortened to `end_time`, and its model.
 fn scenario(end_time: f64) -> (Scenario, Model) {

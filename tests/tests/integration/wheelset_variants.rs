@@ -1,11 +1,9 @@
 //! Wheelset variants: massless elastic rails (Pogorelov 2005, Sect. 4.2) and
 //! independently rotating wheels, against physics.
 
-use crate::common;
-
-use common::*;
 use railmbs_models::{IntegratorSpec, Scenario};
 use railmbs_runtime::NumericEquations;
+use railmbs_testkit::*;
 
 /// Loads a bundled scenario, applies `edit`, runs it with the numeric engine.
 fn run_edited(path: &str, edit: impl FnOnce(&mut Scenario)) -> Table {
@@ -177,14 +175,6 @@ fn elastic_rails_balance_a_lateral_axle_force() {
     // (Y is positive towards the field side: +y on the left, −y on the right).
     assert!((KY_RAIL * dl - yl).abs() < 0.01 * force, "left");
     assert!((KY_RAIL * dr + yr).abs() < 0.01 * force, "right");
-}
-
-/// Times where `y` crosses zero upwards (linear interpolation).
-fn up_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
-    (1..y.len())
-        .filter(|&i| y[i - 1] < 0.0 && y[i] >= 0.0)
-        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * (-y[i - 1]) / (y[i] - y[i - 1]))
-        .collect()
 }
 
 /// Primary suspension of the IRW comparison: yaw held by soft longitudinal

@@ -1,20 +1,10 @@
 //! Wheelsets on the track with wheel–rail contact: physics oracles.
 
-use crate::common;
-
-use common::*;
 use railmbs_runtime::NumericEquations;
+use railmbs_testkit::*;
 use railmbs_wheelrail::conicity::{RollTreatment, conicity_curve};
 use railmbs_wheelrail::geometry::{ContactGeometry, SearchSettings, Track, Wheelset};
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
-
-/// Times where `y` crosses zero upwards (linear interpolation).
-fn up_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
-    (1..y.len())
-        .filter(|&i| y[i - 1] < 0.0 && y[i] >= 0.0)
-        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * (-y[i - 1]) / (y[i] - y[i - 1]))
-        .collect()
-}
 
 /// A free wheelset (S1002 on UIC60 1:40, no suspension) released 2 mm off
 /// centre runs Klingel's kinematic oscillation: wavelength

@@ -3,30 +3,21 @@
 //! 920 mm, gauge 1435.16 mm, back-to-back 1360 mm (taping lines 1500 mm apart). Tolerance by
 //! EN 15302 Annex F: |Δ tan γe| ≤ min(0.05, 0.5 tan γe) at every tabulated amplitude.
 
-use std::path::PathBuf;
-
+use railmbs_testkit::reference_path;
 use railmbs_wheelrail::conicity::{RollTreatment, conicity_curve};
 use railmbs_wheelrail::geometry::{ContactGeometry, SearchSettings, Track, Wheelset};
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
 
-fn reference(rel: &str) -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/reference/"
-    ))
-    .join(rel)
-}
-
 fn case(wheel: &str, bench: &str) -> Vec<(f64, f64, f64)> {
     let s = ProfileSettings::default();
     let w = Profile::read(
-        &reference(&format!("profiles/en15302/{wheel}")),
+        &reference_path(&format!("profiles/en15302/{wheel}")),
         ProfileKind::Wheel,
         &s,
     )
     .unwrap();
     let r = Profile::read(
-        &reference("profiles/en15302/SUIC519A.dat"),
+        &reference_path("profiles/en15302/SUIC519A.dat"),
         ProfileKind::Rail,
         &s,
     )
@@ -34,7 +25,7 @@ fn case(wheel: &str, bench: &str) -> Vec<(f64, f64, f64)> {
     let ws = Wheelset::new(w.clone(), w, 0.46, 1.360);
     let track = Track::new(r.clone(), r, 1.43516);
     let geo = ContactGeometry::new(&ws, &track, SearchSettings::default()).unwrap();
-    let text = std::fs::read_to_string(reference(&format!("conicity/{bench}"))).unwrap();
+    let text = std::fs::read_to_string(reference_path(&format!("conicity/{bench}"))).unwrap();
     let refs: Vec<(f64, f64)> = text
         .lines()
         .filter(|l| !l.trim().is_empty())

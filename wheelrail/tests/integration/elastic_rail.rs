@@ -266,16 +266,15 @@ fn profile_geometry_static_load() {
     use railmbs_wheelrail::elastic_rail::ProfileRailContacts;
     use railmbs_wheelrail::geometry::{ContactGeometry, SearchSettings, Track, Wheelset};
     use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/profiles/");
     let s = ProfileSettings::default();
     let w = Profile::read(
-        std::path::Path::new(&format!("{dir}MBench_S1002_v3.prw")),
+        &railmbs_testkit::model_path("profiles/MBench_S1002_v3.prw"),
         ProfileKind::Wheel,
         &s,
     )
     .unwrap();
     let r = Profile::read(
-        std::path::Path::new(&format!("{dir}MBench_UIC60_v3.prr")),
+        &railmbs_testkit::model_path("profiles/MBench_UIC60_v3.prr"),
         ProfileKind::Rail,
         &s,
     )

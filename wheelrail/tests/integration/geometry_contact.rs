@@ -1,7 +1,6 @@
 //! Contact geometry: symmetry, analytic cone, S1002 on UIC60 1:40 two-point contact, tables.
 
-use std::path::PathBuf;
-
+use railmbs_testkit::model_path;
 use railmbs_wheelrail::conicity::{RollTreatment, RollingRadiusDifference, conicity_curve};
 use railmbs_wheelrail::geometry::{
     Contact, ContactGeometry, ContactTable, GeometryError, SearchSettings, TableSettings, Track,
@@ -9,14 +8,20 @@ use railmbs_wheelrail::geometry::{
 };
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfilePoints, ProfileSettings};
 
-fn bundled(rel: &str) -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../models/profiles/")).join(rel)
-}
-
 fn s1002_uic60() -> (Wheelset, Track) {
     let s = ProfileSettings::default();
-    let w = Profile::read(&bundled("MBench_S1002_v3.prw"), ProfileKind::Wheel, &s).unwrap();
-    let r = Profile::read(&bundled("MBench_UIC60_v3.prr"), ProfileKind::Rail, &s).unwrap();
+    let w = Profile::read(
+        &model_path("profiles/MBench_S1002_v3.prw"),
+        ProfileKind::Wheel,
+        &s,
+    )
+    .unwrap();
+    let r = Profile::read(
+        &model_path("profiles/MBench_UIC60_v3.prr"),
+        ProfileKind::Rail,
+        &s,
+    )
+    .unwrap();
     (
         Wheelset::new(w.clone(), w, 0.46, 1.360),
         Track::new(r.clone(), r, 1.435),

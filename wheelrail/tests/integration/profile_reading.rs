@@ -1,20 +1,13 @@
 //! Profile reading, orientation and smoothing against the files' own numbers and analytic
 //! shapes.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use railmbs_testkit::reference_path;
 use railmbs_wheelrail::profile::{
     Profile, ProfileError, ProfileFormat, ProfileKind, ProfilePoints, ProfileSettings,
     parse_points, read_points,
 };
-
-fn reference(rel: &str) -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/reference/"
-    ))
-    .join(rel)
-}
 
 fn close(a: [f64; 2], b: [f64; 2], tol: f64) -> bool {
     (a[0] - b[0]).abs() <= tol && (a[1] - b[1]).abs() <= tol
@@ -26,7 +19,7 @@ const EXACT: f64 = 1e-12;
 #[test]
 fn simpack_rail_first_and_last_points_in_metres() {
     let p = read_points(
-        &reference("profiles/MBench_UIC60_v3.prr"),
+        &reference_path("profiles/MBench_UIC60_v3.prr"),
         ProfileKind::Rail,
     )
     .unwrap();
@@ -46,12 +39,12 @@ fn simpack_rail_first_and_last_points_in_metres() {
 fn miniprof_rail_agrees_with_simpack_rail_point_by_point() {
     // The .ban holds the same UIC60 points with X towards the gauge side.
     let a = read_points(
-        &reference("profiles/MBench_UIC60_v3.prr"),
+        &reference_path("profiles/MBench_UIC60_v3.prr"),
         ProfileKind::Rail,
     )
     .unwrap();
     let b = read_points(
-        &reference("profiles/MBench_UIC60_v3.ban"),
+        &reference_path("profiles/MBench_UIC60_v3.ban"),
         ProfileKind::Rail,
     )
     .unwrap();
@@ -64,7 +57,7 @@ fn miniprof_rail_agrees_with_simpack_rail_point_by_point() {
 #[test]
 fn simpack_wheel_is_mirrored_with_flange_back_at_minus_70_mm() {
     let p = read_points(
-        &reference("profiles/MBench_S1002_v3.prw"),
+        &reference_path("profiles/MBench_S1002_v3.prw"),
         ProfileKind::Wheel,
     )
     .unwrap();
@@ -89,7 +82,7 @@ fn simpack_wheel_is_mirrored_with_flange_back_at_minus_70_mm() {
 #[test]
 fn two_column_en15302_profiles() {
     let w = read_points(
-        &reference("profiles/en15302/RUIC519A.dat"),
+        &reference_path("profiles/en15302/RUIC519A.dat"),
         ProfileKind::Wheel,
     )
     .unwrap();
@@ -97,7 +90,7 @@ fn two_column_en15302_profiles() {
     assert!(close(w.points[0], [-0.070, -0.009519], 1e-8));
     assert!(close(*w.points.last().unwrap(), [0.065, 0.007493], 1e-8));
     let r = read_points(
-        &reference("profiles/en15302/SUIC519A.dat"),
+        &reference_path("profiles/en15302/SUIC519A.dat"),
         ProfileKind::Rail,
     )
     .unwrap();
@@ -110,11 +103,11 @@ fn miniprof_wheel_from_flange_back() {
     // A MiniProf wheel file: X from the flange back, Y down. Written here from RUIC519A's
     // numbers (X = y + 70, Y = -z): reading it must give RUIC519A's points.
     let a = read_points(
-        &reference("profiles/en15302/RUIC519A.dat"),
+        &reference_path("profiles/en15302/RUIC519A.dat"),
         ProfileKind::Wheel,
     )
     .unwrap();
-    let text = std::fs::read_to_string(reference("profiles/en15302/RUIC519A.dat")).unwrap();
+    let text = std::fs::read_to_string(reference_path("profiles/en15302/RUIC519A.dat")).unwrap();
     let mut whl = String::from("Filename=test.whl\nXYPoints=1000\nColumnDef=X,Y\n\n");
     for l in text.lines().filter(|l| !l.trim().is_empty()) {
         let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
@@ -269,7 +262,7 @@ fn smoothed_profiles_stay_close_to_the_measured_points() {
         ("profiles/MBench_S1002_v3.prw", ProfileKind::Wheel),
         ("profiles/en15302/RUIC519B.dat", ProfileKind::Wheel),
     ] {
-        let pts = read_points(&reference(file), kind).unwrap();
+        let pts = read_points(&reference_path(file), kind).unwrap();
         let p = Profile::from_points(&pts, &ProfileSettings::default()).unwrap();
         for q in &pts.points {
             if q[0] > -0.060 && q[0] < 0.055 {
@@ -318,7 +311,7 @@ fn uic60_prr_is_inclined_1_in_40_and_rotates_back_to_a_symmetric_head() {
     // the 0.02 mm covers the tabulated profile's own asymmetry of about 0.01 mm, found by
     // scanning inclinations: 1:40 is where it is smallest).
     let pts = read_points(
-        &reference("profiles/MBench_UIC60_v3.prr"),
+        &reference_path("profiles/MBench_UIC60_v3.prr"),
         ProfileKind::Rail,
     )
     .unwrap();

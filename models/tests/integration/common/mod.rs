@@ -1,10 +1,11 @@
-//! Shared model texts and helpers for the integration tests.
+//! The model texts of the models crate's tests and the checks of located
+//! errors in them; models from text come from the test kit
+//! ([`railmbs_testkit::try_parse`], said to be in [`FILE`]).
 #![allow(dead_code)]
 
-use railmbs_models::{Model, ModelError, ModelErrors, parse_model};
-use std::path::Path;
+use railmbs_models::{Model, ModelError, ModelErrors};
 
-pub const FILE: &str = "models/mechanisms/x.ron";
+pub use railmbs_testkit::{TEXT_FILE as FILE, try_parse as load};
 
 /// The bundled S1002 wheel profile (SIMPACK `.prw`), for tests that write
 /// their own profile files (profiles are read when a model loads).
@@ -103,10 +104,6 @@ pub const BASE: &str = r#"Model(
     ],
 )
 "#;
-
-pub fn load(text: &str) -> Result<Model, ModelErrors> {
-    parse_model(text, Path::new(FILE))
-}
 
 pub fn full() -> Model {
     load(FULL).unwrap_or_else(|e| panic!("{e}"))

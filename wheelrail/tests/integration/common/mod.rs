@@ -3,19 +3,15 @@
 //! contact patch.
 #![allow(dead_code)]
 
+use railmbs_testkit::reference_path;
 use railmbs_wheelrail::creep::{ContactPatch, Creepages};
 use std::collections::HashMap;
-
-/// The folder of CONTACT's reference results.
-pub const REF: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/reference/contact/"
-);
 
 /// Rows of a CONTACT result CSV as (header → value) lookups (numeric
 /// columns only).
 pub fn contact_rows(file: &str) -> Vec<HashMap<String, f64>> {
-    let mut rd = csv::Reader::from_path(format!("{REF}{file}")).expect("reference CSV");
+    let mut rd =
+        csv::Reader::from_path(reference_path("contact").join(file)).expect("reference CSV");
     let hdr = rd.headers().unwrap().clone();
     rd.records()
         .map(|r| {
