@@ -8,6 +8,7 @@ pub mod bench;
 pub mod conicity;
 pub mod creep;
 pub mod engine;
+pub mod info;
 pub mod plot;
 pub mod run;
 pub mod umgen;

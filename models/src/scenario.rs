@@ -903,9 +903,9 @@ struct RawCoupler {
     interpolation: crate::Interpolation,
 }
 
-/// The constructor name of the file's top-level value (`Scenario`, `Train`),
-/// after whitespace and comments.
-fn top_constructor(text: &str) -> Option<&str> {
+/// The constructor name of the file's top-level value (`Model`, `Scenario`,
+/// `Train`), after whitespace and comments; `None` when there is none.
+pub fn top_constructor(text: &str) -> Option<&str> {
     let mut rest = text;
     loop {
         rest = rest.trim_start();

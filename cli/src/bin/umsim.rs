@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, plot, run};
+use railmbs_cli::{bench, conicity, creep, info, plot, run};
 
 #[derive(Parser)]
 #[command(
@@ -26,6 +26,8 @@ enum Command {
     Creep(creep::Args),
     /// Plot output columns against time or distance (SVG or PNG).
     Plot(plot::Args),
+    /// A model's parameters, macros, coordinates, bodies, force elements and outputs.
+    Info(info::Args),
 }
 
 fn main() {
@@ -36,6 +38,7 @@ fn main() {
         Command::Conicity(a) => conicity::run(a),
         Command::Creep(a) => creep::run(a),
         Command::Plot(a) => plot::run(a),
+        Command::Info(a) => info::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

@@ -5,5 +5,6 @@ mod bench_cli;
 mod common;
 mod conicity_cli;
 mod creep_cli;
+mod info_cli;
 mod plot_cli;
 mod run_cli;

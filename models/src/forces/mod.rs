@@ -137,6 +137,13 @@ macro_rules! force_elements {
         }
 
         impl ForceKind {
+            /// The element's constructor name in model files (`Spring`, `WheelRail`…).
+            pub fn constructor(&self) -> &'static str {
+                match self {
+                    $( ForceKind::$variant(_) => stringify!($ctor), )*
+                }
+            }
+
             /// Every expression of the force element.
             pub fn exprs_mut(&mut self, f: &mut dyn FnMut(&mut Expr)) {
                 match self {
