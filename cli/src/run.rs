@@ -25,7 +25,8 @@ pub struct Args {
     pub quiet: bool,
     /// Sets a model parameter for this run, `NAME=VALUE` (VALUE an expression
     /// over the parameters, in the parameter's own unit, SI); repeatable, and
-    /// it replaces the scenario's own assignment of NAME.
+    /// it replaces the scenario's own assignment of NAME. In a train file it
+    /// is a train-wide parameter (every vehicle whose model has it).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub set: Vec<(String, String)>,
     /// Runs to this end time instead of the scenario's, s.
@@ -47,13 +48,13 @@ fn parse_assignment(text: &str) -> Result<(String, String), String> {
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut scenario = match railmbs_models::load_any_scenario(&args.scenario)? {
         railmbs_models::AnyScenario::Single(s) => s,
-        railmbs_models::AnyScenario::Train(t) => {
-            if !args.set.is_empty() || args.end_time.is_some() {
-                return Err(format!(
-                    "{}: --set and --end-time apply to scenario files, not yet to train files",
-                    args.scenario.display()
-                )
-                .into());
+        railmbs_models::AnyScenario::Train(mut t) => {
+            for (name, value) in &args.set {
+                t.set_parameter(name, value);
+            }
+            if let Some(end) = args.end_time {
+                t.set_end_time(end)
+                    .map_err(|e| format!("--end-time: {e}"))?;
             }
             return run_train(args, &t);
         }

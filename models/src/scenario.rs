@@ -460,6 +460,36 @@ pub fn run_limit_problems(
     problems
 }
 
+/// `end_time` (s) if a run of it with `integrator` and output `interval` (s)
+/// is possible (positive, finite, within [`run_limit_problems`]), else why not.
+fn checked_end_time(
+    end_time: f64,
+    integrator: &IntegratorSpec,
+    interval: f64,
+) -> Result<f64, String> {
+    if !(end_time.is_finite() && end_time > 0.0) {
+        return Err(format!(
+            "end time must be positive and finite, got {end_time} s"
+        ));
+    }
+    match run_limit_problems(end_time, integrator, interval)
+        .into_iter()
+        .next()
+    {
+        Some((_, message)) => Err(message),
+        None => Ok(end_time),
+    }
+}
+
+/// Sets `name` to `value` in a list of parameter assignments, replacing an
+/// earlier assignment of it.
+fn set_assignment(list: &mut Vec<(String, String)>, name: &str, value: &str) {
+    match list.iter_mut().find(|(n, _)| n == name) {
+        Some((_, v)) => *v = value.to_string(),
+        None => list.push((name.to_string(), value.to_string())),
+    }
+}
+
 /// Validates the parts common to `Scenario` and `Train` files (`check`
 /// records an error at the first `key:` of the file when `ok` is false).
 fn common(
@@ -670,16 +700,7 @@ impl Scenario {
     /// # Errors
     /// What is wrong, in one message.
     pub fn set_end_time(&mut self, end_time: f64) -> Result<(), String> {
-        if !(end_time.is_finite() && end_time > 0.0) {
-            return Err(format!(
-                "end time must be positive and finite, got {end_time} s"
-            ));
-        }
-        let problems = run_limit_problems(end_time, &self.integrator, self.output.interval);
-        if let Some((_, message)) = problems.into_iter().next() {
-            return Err(message);
-        }
-        self.end_time = end_time;
+        self.end_time = checked_end_time(end_time, &self.integrator, self.output.interval)?;
         Ok(())
     }
 
@@ -687,10 +708,7 @@ impl Scenario {
     /// parameters), replacing the file's own assignment of it if any
     /// (`umsim run --set`); checked with the model when the run is prepared.
     pub fn set_parameter(&mut self, name: &str, value: &str) {
-        match self.parameters.iter_mut().find(|(n, _)| n == name) {
-            Some((_, v)) => *v = value.to_string(),
-            None => self.parameters.push((name.to_string(), value.to_string())),
-        }
+        set_assignment(&mut self.parameters, name, value);
     }
 
     /// Parameter values of `model` with this scenario's macros and overrides;
@@ -1202,6 +1220,24 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
 }
 
 impl TrainScenario {
+    /// Replaces the end time (s), checked like the file's own (see
+    /// [`Scenario::set_end_time`]).
+    ///
+    /// # Errors
+    /// What is wrong, in one message.
+    pub fn set_end_time(&mut self, end_time: f64) -> Result<(), String> {
+        self.end_time = checked_end_time(end_time, &self.integrator, self.output.interval)?;
+        Ok(())
+    }
+
+    /// Sets the train-wide parameter `name` to the expression `value`
+    /// (every vehicle whose model has it), replacing the file's own
+    /// assignment; a name no vehicle knows is reported when the train is
+    /// built ([`TrainScenario::check_names`]).
+    pub fn set_parameter(&mut self, name: &str, value: &str) {
+        set_assignment(&mut self.parameters, name, value);
+    }
+
     /// Locates a string literal in the train file, if it can still be read.
     fn locate(&self, literal: &str) -> Option<(usize, usize)> {
         let text = std::fs::read_to_string(&self.source).ok()?;

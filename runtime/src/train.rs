@@ -544,9 +544,7 @@ pub fn build_train(
             engines.len()
         )));
     }
-    train
-        .check_names(models)
-        .map_err(|e| setup(e.to_string()))?;
+    train.check_names(models)?;
     let mut vehicles = Vec::new();
     let mut columns_all = Vec::new();
     let mut header = vec!["time".to_string()];

@@ -312,4 +312,27 @@ fn end_time_and_set_override_the_scenario() {
         "{}",
         text(&o.stderr)
     );
+    // A train file: the end time and train-wide parameters.
+    let o = umsim(&[
+        "run",
+        "models/scenarios/train3_straight.ron",
+        "--end-time",
+        "0.2",
+        "--quiet",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(read_csv(&out).1.last().unwrap()[0], 0.2);
+    let o = umsim(&[
+        "run",
+        "models/scenarios/train3_straight.ron",
+        "--set",
+        "nosuch=1",
+    ]);
+    let stderr = text(&o.stderr);
+    assert!(
+        stderr.contains("parameter \"nosuch\": no vehicle's model has this parameter"),
+        "{stderr}"
+    );
 }
