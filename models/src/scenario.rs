@@ -693,6 +693,21 @@ impl Scenario {
         e
     }
 
+    /// The files a run of this scenario reads, with what each is: the
+    /// scenario file, the model file and the track file.
+    pub fn input_files(&self) -> Vec<(&'static str, &Path)> {
+        let mut files = vec![
+            ("scenario file", self.source.as_path()),
+            ("model file", self.model.as_path()),
+        ];
+        files.extend(
+            self.track
+                .as_ref()
+                .map(|t| ("track file", t.file.as_path())),
+        );
+        files
+    }
+
     /// Replaces the end time (s) by `end_time`, checked like the file's own
     /// (`umsim run --end-time`, studies): positive, finite, and within the
     /// run limits with this scenario's integrator and output interval.
@@ -1220,6 +1235,21 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
 }
 
 impl TrainScenario {
+    /// The files a run of this train reads, with what each is: the train
+    /// file, the track file and each vehicle's model file.
+    pub fn input_files(&self) -> Vec<(&'static str, &Path)> {
+        let mut files = vec![
+            ("train file", self.source.as_path()),
+            ("track file", self.track.file.as_path()),
+        ];
+        files.extend(
+            self.vehicles
+                .iter()
+                .map(|v| ("model file", v.model.as_path())),
+        );
+        files
+    }
+
     /// Replaces the end time (s), checked like the file's own (see
     /// [`Scenario::set_end_time`]).
     ///

@@ -638,17 +638,7 @@ pub fn run_train(
     match output {
         Some(path) => {
             let csv = CsvFile::new(path);
-            let mut inputs = vec![
-                ("train file", train.source.as_path()),
-                ("track file", train.track.file.as_path()),
-            ];
-            inputs.extend(
-                train
-                    .vehicles
-                    .iter()
-                    .map(|v| ("model file", v.model.as_path())),
-            );
-            csv.refuse_inputs(inputs)?;
+            csv.refuse_inputs(train.input_files())?;
             run_train_into(train, models, engines, &mut { csv }, progress)
         }
         None => run_train_into(train, models, engines, &mut Discard, progress),

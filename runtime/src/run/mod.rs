@@ -524,18 +524,7 @@ pub fn run_scenario(
     match output {
         Some(path) => {
             let csv = CsvFile::new(path);
-            let mut inputs = vec![
-                ("scenario file", scenario.source.as_path()),
-                ("model file", scenario.model.as_path()),
-            ];
-            inputs.extend(model.source.as_deref().map(|p| ("model file", p)));
-            inputs.extend(
-                scenario
-                    .track
-                    .as_ref()
-                    .map(|t| ("track file", t.file.as_path())),
-            );
-            csv.refuse_inputs(inputs)?;
+            csv.refuse_inputs(scenario.input_files())?;
             run_scenario_into(scenario, model, equations, &mut { csv }, progress)
         }
         None => run_scenario_into(scenario, model, equations, &mut Discard, progress),
