@@ -2,9 +2,11 @@
 //! [--set NAME=VALUE]… [--end-time SECONDS]`.
 
 use crate::engine::{Engine, build_engine};
-use railmbs_runtime::run::{RunSummary, run_scenario};
+use railmbs_runtime::run::{Interruptible, RunSummary, output_sink, run_scenario_into};
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Arguments of `umsim run`.
 #[derive(Debug, clap::Args)]
@@ -78,13 +80,50 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 
     let bar = progress_bar(args);
     let t_end = scenario.end_time;
-    let summary = run_scenario(&scenario, &model, equations, output.as_deref(), |t| {
+    let mut file = output_sink(output.as_deref(), &scenario.input_files())?;
+    let mut sink = Interruptible::new(&mut *file, interrupt_flag());
+    let summary = run_scenario_into(&scenario, &model, equations, &mut sink, |t| {
         if let Some(b) = &bar {
             b.set_position((1000.0 * t / t_end) as u64);
             b.set_message(format!("{t:.3}"));
         }
-    })?;
-    finish(args, bar, summary, output)
+    });
+    finish(
+        args,
+        bar,
+        interrupted_note(summary, output.as_deref())?,
+        output,
+    )
+}
+
+/// A flag set by Ctrl-C (SIGINT): the run stops at its next output row and
+/// keeps what it wrote. A second Ctrl-C ends the process at once.
+fn interrupt_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let set = flag.clone();
+    // Only one handler per process; a second call (tests in one process)
+    // keeps the first, which is the same.
+    let _ = ctrlc::set_handler(move || {
+        if set.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    flag
+}
+
+/// An interrupted run's error, with where its rows are.
+fn interrupted_note(
+    summary: Result<RunSummary, railmbs_runtime::run::RunError>,
+    output: Option<&std::path::Path>,
+) -> Result<RunSummary, Box<dyn std::error::Error>> {
+    match summary {
+        Err(e @ railmbs_runtime::run::RunError::Interrupted { .. }) => Err(match output {
+            Some(path) => format!("{e}; {} keeps them", path.display()),
+            None => format!("{e} (no output file)"),
+        }
+        .into()),
+        other => Ok(other?),
+    }
 }
 
 /// A progress bar on a terminal unless `--quiet`.
@@ -153,14 +192,20 @@ fn run_train(
     let output = args.output.clone().or_else(|| train.output_file.clone());
     let bar = progress_bar(args);
     let t_end = train.end_time;
-    let summary =
-        railmbs_runtime::train::run_train(train, &models, engines, output.as_deref(), |t| {
-            if let Some(b) = &bar {
-                b.set_position((1000.0 * t / t_end) as u64);
-                b.set_message(format!("{t:.3}"));
-            }
-        })?;
-    finish(args, bar, summary, output)
+    let mut file = output_sink(output.as_deref(), &train.input_files())?;
+    let mut sink = Interruptible::new(&mut *file, interrupt_flag());
+    let summary = railmbs_runtime::train::run_train_into(train, &models, engines, &mut sink, |t| {
+        if let Some(b) = &bar {
+            b.set_position((1000.0 * t / t_end) as u64);
+            b.set_message(format!("{t:.3}"));
+        }
+    });
+    finish(
+        args,
+        bar,
+        interrupted_note(summary, output.as_deref())?,
+        output,
+    )
 }
 
 /// Clears the progress bar, prints the summary, turns a simulation error

@@ -31,9 +31,7 @@ use crate::run::grid::Row;
 use crate::run::scenario::{
     check_integrator, continuous_velocities, drive_track_frames, scenario_state,
 };
-use crate::run::{
-    CsvFile, Discard, OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner,
-};
+use crate::run::{OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner};
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
@@ -635,14 +633,8 @@ pub fn run_train(
     output: Option<&Path>,
     progress: impl FnMut(f64),
 ) -> Result<RunSummary, RunError> {
-    match output {
-        Some(path) => {
-            let csv = CsvFile::new(path);
-            csv.refuse_inputs(train.input_files())?;
-            run_train_into(train, models, engines, &mut { csv }, progress)
-        }
-        None => run_train_into(train, models, engines, &mut Discard, progress),
-    }
+    let mut sink = crate::run::output_sink(output, &train.input_files())?;
+    run_train_into(train, models, engines, &mut *sink, progress)
 }
 
 /// [`run_train`] writing the rows to `sink`.

@@ -336,3 +336,49 @@ fn end_time_and_set_override_the_scenario() {
         "{stderr}"
     );
 }
+
+/// Ctrl-C (SIGINT) stops a run at its next output row with a message naming
+/// the rows kept and the file; the CSV is complete up to there.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_stops_the_run_and_says_what_was_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("long.csv");
+    let child = Command::new(env!("CARGO_BIN_EXE_umsim"))
+        .args([
+            "run",
+            "models/scenarios/double_pendulum.ron",
+            "--end-time",
+            "100000",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&out)
+        .current_dir(repo_path(""))
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until rows are being written, then interrupt.
+    let start = std::time::Instant::now();
+    while std::fs::metadata(&out).map_or(0, |m| m.len()) < 10_000 {
+        assert!(start.elapsed().as_secs() < 60, "no rows written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted after"), "{stderr}");
+    assert!(stderr.contains("long.csv keeps them"), "{stderr}");
+    let (_, rows) = read_csv(&out);
+    let last = rows.last().unwrap()[0];
+    assert!(
+        stderr.contains(&format!("the last at t = {last} s")),
+        "{stderr} (last row {last})"
+    );
+    assert!(last < 100000.0);
+}

@@ -19,7 +19,7 @@ pub mod sliding_mean;
 pub use assessment::{AssessmentReducer, LoadSample};
 pub use columns::xyz_angles;
 pub use scenario::{InitialState, scenario_state};
-pub use sink::{CsvFile, Discard, OutputSink, Table};
+pub use sink::{CsvFile, Discard, Interruptible, OutputSink, Table};
 
 use crate::Equations;
 use crate::integrate::{self, IntegrationStats, Park, ParkSettings, Rk4, Rk4Settings, Stepper};
@@ -56,6 +56,15 @@ pub enum RunError {
     /// coordinate), located in the scenario file.
     #[error(transparent)]
     Model(#[from] railmbs_models::ModelErrors),
+    /// The run was interrupted (Ctrl-C): it stopped at the next output row,
+    /// and the rows before were written.
+    #[error("interrupted after {rows} output rows{}", last_time.map_or(String::new(), |t| format!(", the last at t = {t} s")))]
+    Interrupted {
+        /// Rows written.
+        rows: usize,
+        /// Time of the last row written, s.
+        last_time: Option<f64>,
+    },
 }
 
 /// What a finished (or stopped) run did.
@@ -510,6 +519,25 @@ fn prepare(
     })
 }
 
+/// The sink of a run writing to `output` (a [`CsvFile`], refused when it is
+/// one of the run's `inputs`), or a [`Discard`] without one.
+///
+/// # Errors
+/// [`RunError::Setup`] when `output` is one of `inputs`.
+pub fn output_sink(
+    output: Option<&Path>,
+    inputs: &[(&str, &Path)],
+) -> Result<Box<dyn OutputSink>, RunError> {
+    Ok(match output {
+        Some(path) => {
+            let csv = CsvFile::new(path);
+            csv.refuse_inputs(inputs.iter().copied())?;
+            Box::new(csv)
+        }
+        None => Box::new(Discard),
+    })
+}
+
 /// Runs `scenario` on `model` with the engine `equations` and writes the output
 /// CSV to `output` (if given). `progress` is called with the simulated time
 /// now and then. A simulation error stops the run: rows up to that point are
@@ -521,14 +549,8 @@ pub fn run_scenario(
     output: Option<&Path>,
     progress: impl FnMut(f64),
 ) -> Result<RunSummary, RunError> {
-    match output {
-        Some(path) => {
-            let csv = CsvFile::new(path);
-            csv.refuse_inputs(scenario.input_files())?;
-            run_scenario_into(scenario, model, equations, &mut { csv }, progress)
-        }
-        None => run_scenario_into(scenario, model, equations, &mut Discard, progress),
-    }
+    let mut sink = output_sink(output, &scenario.input_files())?;
+    run_scenario_into(scenario, model, equations, &mut *sink, progress)
 }
 
 /// [`run_scenario`] writing the rows to `sink` (a [`CsvFile`], a [`Table`]…).

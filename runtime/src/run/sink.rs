@@ -215,3 +215,54 @@ impl OutputSink for Discard {
         Ok(())
     }
 }
+
+/// A sink that stops the run at the next row once `flag` is set (by a
+/// Ctrl-C handler, say), with [`RunError::Interrupted`] naming the time of
+/// the last row written; everything before is kept (the inner sink is
+/// finished as after any stop).
+#[derive(Debug)]
+pub struct Interruptible<S> {
+    inner: S,
+    flag: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    rows: usize,
+    last_time: Option<f64>,
+}
+
+impl<S: OutputSink> Interruptible<S> {
+    /// `inner`, stopped when `flag` becomes true.
+    pub fn new(inner: S, flag: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Self {
+        Self {
+            inner,
+            flag,
+            rows: 0,
+            last_time: None,
+        }
+    }
+}
+
+impl<S: OutputSink> OutputSink for Interruptible<S> {
+    fn begin(&mut self, header: &[String]) -> Result<(), RunError> {
+        self.inner.begin(header)
+    }
+
+    fn row(&mut self, values: &[f64]) -> Result<(), RunError> {
+        if self.flag.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(RunError::Interrupted {
+                rows: self.rows,
+                last_time: self.last_time,
+            });
+        }
+        self.inner.row(values)?;
+        self.rows += 1;
+        self.last_time = values.first().copied();
+        Ok(())
+    }
+
+    fn accepted_loads(&mut self, samples: &[LoadSample], name: &dyn Fn(usize) -> String) {
+        self.inner.accepted_loads(samples, name);
+    }
+
+    fn finish(&mut self) -> Result<(), RunError> {
+        self.inner.finish()
+    }
+}
