@@ -10,5 +10,6 @@ mod load;
 mod parameters;
 mod scenario;
 mod subsystems;
+mod torsion_spring;
 mod validation;
 mod wheel_rail;
