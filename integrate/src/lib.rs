@@ -95,7 +95,9 @@ pub trait Stepper {
     /// The solver's errors (see [`Park::new`], [`Rk4::new`]), any error of
     /// the system (including those of `accept_step`), and
     /// [`SimError::Other`] when the stop time has been reached.
-    fn step(&mut self) -> Result<StepView<'_>, SimError>;
+    fn step(&mut self) -> Result<StepView<'_>, SimError> {
+        self.step_observed(&mut |_, _| Ok(()))
+    }
 
     /// As [`Stepper::step`], and calls `before_accept` with the system and
     /// the state at the end of the step once the step has passed its tests

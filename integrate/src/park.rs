@@ -1180,15 +1180,11 @@ impl<S: MechanicalSystem> Stepper for Park<S> {
     /// corrector, the local error test, rejected attempts retried with a
     /// smaller step (or a fresh Jacobian) until one is accepted.
     /// [`MechanicalSystem::accept_step`] is called once with its state.
-    fn step(&mut self) -> Result<StepView<'_>, SimError> {
-        self.advance(None)
-    }
-
     fn step_observed(
         &mut self,
         before_accept: BeforeAccept<'_, S>,
     ) -> Result<StepView<'_>, SimError> {
-        self.advance(Some(before_accept))
+        self.advance(before_accept)
     }
 
     fn stats(&self) -> &IntegrationStats {
@@ -1205,12 +1201,9 @@ impl<S: MechanicalSystem> Stepper for Park<S> {
 }
 
 impl<S: MechanicalSystem> Park<S> {
-    /// One accepted step, calling `before_accept` (if any) with its end state
+    /// One accepted step, calling `before_accept` with its end state
     /// before [`MechanicalSystem::accept_step`] (see [`Stepper::step_observed`]).
-    fn advance(
-        &mut self,
-        mut before_accept: Option<BeforeAccept<'_, S>>,
-    ) -> Result<StepView<'_>, SimError> {
+    fn advance(&mut self, before_accept: BeforeAccept<'_, S>) -> Result<StepView<'_>, SimError> {
         let s = &self.settings;
         let (t, t_end, t0) = (self.t, self.t_stop, self.t0);
         if t >= t_end {
@@ -1397,19 +1390,17 @@ impl<S: MechanicalSystem> Park<S> {
                 w.ha[0].copy_from(&w.a);
                 w.lambda.copy_from(&w.lam);
             }
-            if let Some(observe) = before_accept.as_mut() {
-                observe(
-                    system,
-                    StepView {
-                        t: t_new,
-                        h: hs,
-                        q: w.hq[0].as_slice(),
-                        v: w.hv[0].as_slice(),
-                        accel: w.ha[0].as_slice(),
-                        lambda: w.lambda.as_slice(),
-                    },
-                )?;
-            }
+            before_accept(
+                system,
+                StepView {
+                    t: t_new,
+                    h: hs,
+                    q: w.hq[0].as_slice(),
+                    v: w.hv[0].as_slice(),
+                    accel: w.ha[0].as_slice(),
+                    lambda: w.lambda.as_slice(),
+                },
+            )?;
             st.steps += 1;
             system.accept_step(t_new, w.hq[0].as_slice(), w.hv[0].as_slice())?;
             if iterations >= 6 || theta_max > 0.2 {

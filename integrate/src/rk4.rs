@@ -192,15 +192,11 @@ impl<S: MechanicalSystem> Stepper for Rk4<S> {
         self.t_stop
     }
 
-    fn step(&mut self) -> Result<StepView<'_>, SimError> {
-        self.advance(None)
-    }
-
     fn step_observed(
         &mut self,
         before_accept: BeforeAccept<'_, S>,
     ) -> Result<StepView<'_>, SimError> {
-        self.advance(Some(before_accept))
+        self.advance(before_accept)
     }
 
     fn stats(&self) -> &IntegrationStats {
@@ -217,12 +213,9 @@ impl<S: MechanicalSystem> Stepper for Rk4<S> {
 }
 
 impl<S: MechanicalSystem> Rk4<S> {
-    /// One step, calling `before_accept` (if any) with its end state before
+    /// One step, calling `before_accept` with its end state before
     /// [`MechanicalSystem::accept_step`] (see [`Stepper::step_observed`]).
-    fn advance(
-        &mut self,
-        before_accept: Option<BeforeAccept<'_, S>>,
-    ) -> Result<StepView<'_>, SimError> {
+    fn advance(&mut self, before_accept: BeforeAccept<'_, S>) -> Result<StepView<'_>, SimError> {
         let (t, h, t_end) = (self.t, self.h, self.t_stop);
         if t >= t_end {
             return Err(at_stop_time(t));
@@ -265,35 +258,29 @@ impl<S: MechanicalSystem> Rk4<S> {
         check_finite(t_new, "velocity v", self.v.as_slice())?;
         self.stats.steps += 1;
         // The acceleration at the new state is the next step's first stage.
-        // An observer sees it before the step is accepted; it is evaluated
+        // The observer sees it before the step is accepted; it is evaluated
         // again after acceptance only where accepting can change it.
-        let observed = match before_accept {
-            Some(observe) => {
-                acceleration(
-                    &mut self.system,
-                    t_new,
-                    &self.q,
-                    &self.v,
-                    &mut self.mass,
-                    &mut self.a1,
-                    &mut self.stats,
-                )?;
-                let view = StepView {
-                    t: t_new,
-                    h: hs,
-                    q: self.q.as_slice(),
-                    v: self.v.as_slice(),
-                    accel: self.a1.as_slice(),
-                    lambda: &[],
-                };
-                observe(&mut self.system, view)?;
-                true
-            }
-            None => false,
+        acceleration(
+            &mut self.system,
+            t_new,
+            &self.q,
+            &self.v,
+            &mut self.mass,
+            &mut self.a1,
+            &mut self.stats,
+        )?;
+        let view = StepView {
+            t: t_new,
+            h: hs,
+            q: self.q.as_slice(),
+            v: self.v.as_slice(),
+            accel: self.a1.as_slice(),
+            lambda: &[],
         };
+        before_accept(&mut self.system, view)?;
         self.system
             .accept_step(t_new, self.q.as_slice(), self.v.as_slice())?;
-        if !observed || self.system.remembers_accepted_steps() {
+        if self.system.remembers_accepted_steps() {
             acceleration(
                 &mut self.system,
                 t_new,
