@@ -191,16 +191,22 @@ fn check_library_file(path: &Path) -> Result<(), PluginError> {
         path: path.to_path_buf(),
         reason,
     };
-    let data = std::fs::read(path).map_err(|e| not_a_library(e.to_string()))?;
-    let file = object::File::parse(&*data)
+    // Only the headers are read (ReadCache reads the ranges parsing asks
+    // for), not the whole library.
+    let file = std::fs::File::open(path).map_err(|e| not_a_library(e.to_string()))?;
+    let len = file
+        .metadata()
+        .map_err(|e| not_a_library(e.to_string()))?
+        .len();
+    let data = object::ReadCache::new(file);
+    let parsed = object::File::parse(&data)
         .map_err(|e| not_a_library(format!("not an object file the loader can map ({e})")))?;
-    for segment in file.segments() {
+    for segment in parsed.segments() {
         let (offset, size) = segment.file_range();
         let end = offset.saturating_add(size);
-        if end > data.len() as u64 {
+        if end > len {
             return Err(not_a_library(format!(
-                "truncated: a segment ends at byte {end}, the file has {} bytes",
-                data.len()
+                "truncated: a segment ends at byte {end}, the file has {len} bytes"
             )));
         }
     }
