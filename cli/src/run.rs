@@ -99,16 +99,22 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 /// A flag set by Ctrl-C (SIGINT): the run stops at its next output row and
 /// keeps what it wrote. A second Ctrl-C ends the process at once.
 fn interrupt_flag() -> Arc<AtomicBool> {
-    let flag = Arc::new(AtomicBool::new(false));
-    let set = flag.clone();
-    // Only one handler per process; a second call (tests in one process)
-    // keeps the first, which is the same.
-    let _ = ctrlc::set_handler(move || {
-        if set.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    });
-    flag
+    // One handler per process (the system allows only one), installed by
+    // the first run; later runs share its flag.
+    static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        let set = flag.clone();
+        // Without a handler (another one is installed) Ctrl-C keeps its
+        // default: the process ends, the rows written are kept.
+        let _ = ctrlc::set_handler(move || {
+            if set.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+        flag
+    })
+    .clone()
 }
 
 /// An interrupted run's error, with where its rows are.
