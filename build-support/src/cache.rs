@@ -144,8 +144,9 @@ pub fn write_source(dir: &Path, file_name: &str, contents: &str) -> Result<PathB
     Ok(dest)
 }
 
-/// Atomic write of `bytes` to `dest` (whose parent directory must exist).
-pub(crate) fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), BuildError> {
+/// Atomic write of `bytes` to `dest` (whose parent directory must exist):
+/// readers see the old file or the whole new one, never a partial one.
+pub fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), BuildError> {
     let dir = dest.parent().unwrap_or(Path::new("."));
     let mut builder = tempfile::Builder::new();
     builder.prefix(".tmp-write-");

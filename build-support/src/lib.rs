@@ -100,7 +100,7 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-pub use cache::{CACHE_DIR_ENV, resolve_cache_dir, write_source};
+pub use cache::{CACHE_DIR_ENV, resolve_cache_dir, write_atomic, write_source};
 pub use error::BuildError;
 pub use rustc::{Rustc, find_rustc};
 

@@ -230,6 +230,7 @@ impl Default for SearchSettings {
 }
 
 /// One contact point of a wheel with its rail.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Contact {
     /// Vertical gap (m) between wheel and rail at the contact for wheelset height `z = 0`
@@ -279,6 +280,7 @@ impl Contact {
 
 /// The contacts of one wheel: one, or two in two-point contact (ordered from the field side
 /// to the flange, i.e. the tread contact first).
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ContactSet {
     /// Number of contacts (1 or 2).
@@ -330,6 +332,7 @@ pub struct ContactGeometry {
 }
 
 /// Rigid wheelset position where both wheels touch their rails.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidContact {
     /// Lateral shift (m).
@@ -883,7 +886,8 @@ impl Default for TableSettings {
 
 /// Contact tables over lateral shift and roll, computed once before a simulation and
 /// interpolated during it, plus the rigid contact geometry functions over the lateral shift.
-#[derive(Debug, Clone)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ContactTable {
     ny: usize,
     nr: usize,

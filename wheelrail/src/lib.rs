@@ -14,6 +14,12 @@
 //! - [`kalker`]: Kalker's creepage coefficients;
 //! - [`elastic_rail`]: massless elastic rail with inner/outer iterations.
 
+/// Digest of this crate's source files and of the compiler that built it
+/// (see `build.rs`): anything cached from this crate's results, such as a
+/// contact table on disk, is valid only under the same digest, so a change
+/// to the code invalidates such caches by itself.
+pub const SOURCE_DIGEST: &str = env!("RAILMBS_WHEELRAIL_SOURCE_DIGEST");
+
 pub mod conicity;
 pub mod creep;
 pub mod creepage;

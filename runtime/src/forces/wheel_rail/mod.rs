@@ -78,6 +78,7 @@ mod elastic;
 mod kinematics;
 mod preparation;
 mod solve;
+mod table_cache;
 
 pub use assessment::{nadal_limit, prudhomme_limit};
 pub use kinematics::MIN_ROLLING_SPEED;

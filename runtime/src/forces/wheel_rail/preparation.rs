@@ -5,6 +5,7 @@
 //! contact table built from them (or reused from another wheelset of the run
 //! with the same profiles and dimensions) and the creep law.
 
+use super::table_cache::{TableCache, TableInputs, TableKey};
 use super::{WheelRailContact, nadal_limit};
 use crate::forces::eval_scalar;
 use crate::system::SimError;
@@ -30,7 +31,7 @@ pub struct TrackBinding {
     pub body_offsets: Vec<Option<f64>>,
     /// Contact tables already built in this run, shared between wheelsets
     /// with the same profiles and dimensions.
-    pub tables: Mutex<HashMap<String, Arc<PreparedContact>>>,
+    pub(crate) tables: Mutex<HashMap<TableKey, Arc<PreparedContact>>>,
 }
 
 /// Profiles on the track: the contact table and what is derived from it.
@@ -109,21 +110,39 @@ impl WheelRailContact {
     pub(super) fn prepare(&self, binding: &TrackBinding) -> Result<Arc<PreparedContact>, SimError> {
         let track = &binding.track;
         let t = &self.spec.table;
-        let key = format!(
-            "{:?}|{:?}|{}|{}|{}|{}|{}|{}|{}|{}|{}|{}",
-            self.spec.wheel_profiles.each_ref().map(|f| &f.path),
-            self.spec.rail_profiles.each_ref().map(|f| &f.path),
-            self.spec.rail_profiles_inclined,
-            self.c.radius,
-            self.c.flange_back_distance,
-            self.c.taping_offset,
-            track.nominal_gauge(),
-            track.rail_inclination(),
-            t.y_max,
-            t.dy,
-            t.roll_max,
-            t.droll
-        );
+        let inclination = if self.spec.rail_profiles_inclined {
+            0.0
+        } else {
+            track.rail_inclination().atan()
+        };
+        let settings = |rail_inclination: f64| ProfileSettings {
+            rail_inclination,
+            ..ProfileSettings::default()
+        };
+        let [wheel_left, wheel_right] = &self.spec.wheel_profiles;
+        let [rail_left, rail_right] = &self.spec.rail_profiles;
+        let inputs = TableInputs {
+            wheels: [
+                (&wheel_left.points, settings(0.0)),
+                (&wheel_right.points, settings(0.0)),
+            ],
+            rails: [
+                (&rail_left.points, settings(inclination)),
+                (&rail_right.points, settings(inclination)),
+            ],
+            radius: self.c.radius,
+            flange_back_distance: self.c.flange_back_distance,
+            taping_offset: self.c.taping_offset,
+            gauge: track.nominal_gauge(),
+            search: SearchSettings::default(),
+            table: TableSettings {
+                y_max: t.y_max,
+                dy: t.dy,
+                roll_max: t.roll_max,
+                droll: t.droll,
+            },
+        };
+        let key = inputs.key();
         let mut tables = binding
             .tables
             .lock()
@@ -133,46 +152,33 @@ impl WheelRailContact {
         }
         // The profiles were read and validated when the model was loaded;
         // here they are smoothed, the rails inclined as the track says.
-        let read = |file: &ProfileFile, inclination: f64| {
-            let settings = ProfileSettings {
-                rail_inclination: inclination,
-                ..ProfileSettings::default()
+        let build = || {
+            let read = |file: &ProfileFile, settings: ProfileSettings| {
+                Profile::from_points(&file.points, &settings)
+                    .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
             };
-            Profile::from_points(&file.points, &settings)
-                .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
+            let wheelset = geometry::Wheelset::new(
+                read(wheel_left, inputs.wheels[0].1)?,
+                read(wheel_right, inputs.wheels[1].1)?,
+                self.c.radius,
+                self.c.flange_back_distance,
+            );
+            let wheelset = geometry::Wheelset {
+                taping_line_offset: self.c.taping_offset,
+                ..wheelset
+            };
+            let rails = geometry::Track::new(
+                read(rail_left, inputs.rails[0].1)?,
+                read(rail_right, inputs.rails[1].1)?,
+                track.nominal_gauge(),
+            );
+            ContactTable::new(&wheelset, &rails, inputs.search, inputs.table)
+                .map_err(|e| self.err(format!("contact table: {e}")))
         };
-        let inclination = if self.spec.rail_profiles_inclined {
-            0.0
-        } else {
-            track.rail_inclination().atan()
+        let table = match TableCache::default_location() {
+            Some(cache) => cache.get_or_build(&key, build)?,
+            None => build()?,
         };
-        let wheelset = geometry::Wheelset::new(
-            read(&self.spec.wheel_profiles[0], 0.0)?,
-            read(&self.spec.wheel_profiles[1], 0.0)?,
-            self.c.radius,
-            self.c.flange_back_distance,
-        );
-        let wheelset = geometry::Wheelset {
-            taping_line_offset: self.c.taping_offset,
-            ..wheelset
-        };
-        let rails = geometry::Track::new(
-            read(&self.spec.rail_profiles[0], inclination)?,
-            read(&self.spec.rail_profiles[1], inclination)?,
-            track.nominal_gauge(),
-        );
-        let table = ContactTable::new(
-            &wheelset,
-            &rails,
-            SearchSettings::default(),
-            TableSettings {
-                y_max: t.y_max,
-                dy: t.dy,
-                roll_max: t.roll_max,
-                droll: t.droll,
-            },
-        )
-        .map_err(|e| self.err(format!("contact table: {e}")))?;
         let flange_angle = table
             .rigid_functions()
             .iter()
