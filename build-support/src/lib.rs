@@ -93,6 +93,7 @@
 
 mod cache;
 mod error;
+pub mod index;
 mod rustc;
 
 use std::ffi::OsString;

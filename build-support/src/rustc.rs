@@ -108,7 +108,7 @@ pub fn find_rustc(explicit: Option<&Path>) -> Result<Rustc, BuildError> {
 }
 
 /// The first `rustc` (with the platform's executable suffix) in the directories of `path_var`.
-fn search_path(path_var: Option<OsString>) -> Option<PathBuf> {
+pub(crate) fn search_path(path_var: Option<OsString>) -> Option<PathBuf> {
     let name = format!("rustc{}", std::env::consts::EXE_SUFFIX);
     std::env::split_paths(&path_var?)
         .filter(|d| !d.as_os_str().is_empty())

@@ -1,6 +1,6 @@
 //! Choosing the equations-of-motion engine for a model.
 
-use railmbs_codegen::{BuiltPlugin, GenerateOptions};
+use railmbs_codegen::{GenerateOptions, PluginFile};
 use railmbs_models::Model;
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::io::IsTerminal;
@@ -20,7 +20,7 @@ pub enum Engine {
 pub fn build_symbolic(
     model: &Model,
     portable: bool,
-) -> Result<BuiltPlugin, Box<dyn std::error::Error>> {
+) -> Result<PluginFile, Box<dyn std::error::Error>> {
     let mut opts = GenerateOptions::new();
     opts.portable = portable;
     // On a terminal, say why the first run of a model waits (derivation and
@@ -32,7 +32,7 @@ pub fn build_symbolic(
             model.name
         );
     }
-    let built = railmbs_codegen::build_plugin(model, &opts, None);
+    let built = railmbs_codegen::find_or_build_plugin(model, &opts, None);
     if terminal {
         match &built {
             Ok(b) if b.cache_hit => eprintln!(" cached"),

@@ -178,14 +178,77 @@ pub struct BuiltPlugin {
     pub rebuilt_damaged: Option<String>,
 }
 
-/// Generates and compiles the plugin of `model` through the cache
-/// (`cache_dir`, else `RAILMBS_CACHE_DIR`, else the platform cache directory).
-pub fn build_plugin(
+/// Digest of the generator's own code and compiler (see `build.rs`): part of
+/// [`input_digest`], so a plugin indexed by an older generator is not found.
+pub const GENERATOR_DIGEST: &str = env!("RAILMBS_GENERATOR_DIGEST");
+
+/// A hash of everything the plugin source of `model` with `opts` is
+/// generated from: the whole model (every field but the path it was read
+/// from, so parameter defaults and initial values count even where the
+/// source does not depend on them), the options, the plugin ABI and
+/// [`GENERATOR_DIGEST`]. The key of the plugin index
+/// ([`railmbs_build_support::index`]).
+pub fn input_digest(model: &Model, opts: &GenerateOptions) -> String {
+    let mut located = model.clone();
+    located.source = None;
+    let mut h = blake3::Hasher::new();
+    h.update(b"railmbs plugin input v1\0");
+    h.update(GENERATOR_DIGEST.as_bytes());
+    h.update(&railmbs_plugin_abi::ABI_VERSION.to_le_bytes());
+    h.update(format!("\0{opts:?}\0{located:?}").as_bytes());
+    h.finalize().to_hex().to_string()
+}
+
+/// The plugin library of a model in the cache: what [`find_or_build_plugin`]
+/// returns.
+#[derive(Debug, Clone)]
+pub struct PluginFile {
+    /// The library in the cache.
+    pub path: PathBuf,
+    /// `None` unless it was compiled now.
+    pub compile_time: Option<Duration>,
+    /// Whether the library came from the cache.
+    pub cache_hit: bool,
+    /// Whether it was found through the plugin index, without generating its
+    /// source or running rustc.
+    pub indexed: bool,
+    /// What was wrong with a damaged cache entry that was rebuilt.
+    pub rebuilt_damaged: Option<String>,
+}
+
+/// The compiled plugin of `model`: found through the plugin index when an
+/// earlier build recorded it (no derivation, no source, no rustc process:
+/// what a run of a cached model waits for), else [`build_plugin`], which
+/// records it for next time.
+pub fn find_or_build_plugin(
     model: &Model,
     opts: &GenerateOptions,
     cache_dir: Option<PathBuf>,
-) -> Result<BuiltPlugin, CodegenError> {
-    let generated = generate(model, opts)?;
+) -> Result<PluginFile, CodegenError> {
+    let input = input_digest(model, opts);
+    if let Some(out) =
+        railmbs_build_support::index::lookup(&input, &build_options(opts, cache_dir.clone()))
+    {
+        return Ok(PluginFile {
+            path: out.path,
+            compile_time: None,
+            cache_hit: true,
+            indexed: true,
+            rebuilt_damaged: None,
+        });
+    }
+    let built = build_plugin(model, opts, cache_dir)?;
+    Ok(PluginFile {
+        path: built.path,
+        compile_time: built.compile_time,
+        cache_hit: built.cache_hit,
+        indexed: false,
+        rebuilt_damaged: built.rebuilt_damaged,
+    })
+}
+
+/// The build options of a plugin generated with `opts`.
+fn build_options(opts: &GenerateOptions, cache_dir: Option<PathBuf>) -> BuildOptions {
     let mut build = BuildOptions::new(railmbs_plugin_abi::ABI_VERSION);
     if !opts.portable {
         build.extra_flags = native_cpu_flags();
@@ -193,7 +256,21 @@ pub fn build_plugin(
     if let Some(dir) = cache_dir {
         build = build.with_cache_dir(dir);
     }
+    build
+}
+
+/// Generates and compiles the plugin of `model` through the cache, and
+/// records it in the plugin index
+/// (`cache_dir`, else `RAILMBS_CACHE_DIR`, else the platform cache directory).
+pub fn build_plugin(
+    model: &Model,
+    opts: &GenerateOptions,
+    cache_dir: Option<PathBuf>,
+) -> Result<BuiltPlugin, CodegenError> {
+    let generated = generate(model, opts)?;
+    let build = build_options(opts, cache_dir);
     let out = railmbs_build_support::build_plugin(&generated.source, &build)?;
+    railmbs_build_support::index::record(&input_digest(model, opts), &build, &out);
     Ok(BuiltPlugin {
         path: out.path,
         compile_time: out.compile_time,

@@ -281,3 +281,70 @@ fn symbolic_and_numeric_engines_give_the_same_trajectories() {
         }
     }
 }
+
+#[test]
+fn plugin_index_finds_a_built_plugin_without_generating_and_never_a_stale_one() {
+    use railmbs_codegen::{GenerateOptions, find_or_build_plugin, input_digest};
+    let cache = tempfile::tempdir().unwrap();
+    let dir = || Some(cache.path().to_path_buf());
+    let model = mechanism("pendulum");
+    let opts = GenerateOptions::new();
+
+    let first = find_or_build_plugin(&model, &opts, dir()).unwrap();
+    assert!(!first.indexed && !first.cache_hit, "{first:?}");
+    let again = find_or_build_plugin(&model, &opts, dir()).unwrap();
+    assert!(again.indexed && again.cache_hit, "{again:?}");
+    assert_eq!(again.path, first.path);
+
+    // Another default value: other generator input, so not found in the
+    // index; the source does not depend on it, so the library is a cache hit.
+    let mut other_default = model.clone();
+    other_default.parameters[0].default = railmbs_models::Expr::Num(2.0);
+    assert_ne!(
+        input_digest(&other_default, &opts),
+        input_digest(&model, &opts)
+    );
+    let other = find_or_build_plugin(&other_default, &opts, dir()).unwrap();
+    assert!(!other.indexed && other.cache_hit, "{other:?}");
+    assert_eq!(other.path, first.path);
+
+    // A truncated library is never handed out by the index: rebuilt.
+    let bytes = std::fs::read(&first.path).unwrap();
+    std::fs::write(&first.path, &bytes[..bytes.len() / 2]).unwrap();
+    let rebuilt = find_or_build_plugin(&model, &opts, dir()).unwrap();
+    assert!(
+        !rebuilt.indexed && rebuilt.rebuilt_damaged.is_some(),
+        "{rebuilt:?}"
+    );
+    assert_eq!(std::fs::read(&rebuilt.path).unwrap(), bytes);
+
+    // An entry whose compiler is gone (a toolchain replaced in place) is not used.
+    let index = cache.path().join("index");
+    let entries: Vec<_> = std::fs::read_dir(&index)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(
+        entries.len(),
+        2,
+        "one entry per generator input: {entries:?}"
+    );
+    for entry in &entries {
+        let text = std::fs::read_to_string(entry).unwrap();
+        let gone: String = text
+            .lines()
+            .map(|l| match l.strip_prefix("driver ") {
+                Some(_) => "driver /nonexistent/librustc_driver-0.so".to_owned(),
+                None => l.to_owned(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(entry, gone + "\n").unwrap();
+    }
+    let relooked = find_or_build_plugin(&model, &opts, dir()).unwrap();
+    assert!(!relooked.indexed && relooked.cache_hit, "{relooked:?}");
+    let last = find_or_build_plugin(&model, &opts, dir()).unwrap();
+    assert!(last.indexed);
+    // Loaded only now: truncating a loaded library (above) would crash the process.
+    Plugin::load_for(&last.path, &model).unwrap();
+}
