@@ -244,6 +244,10 @@ fn finish(
     }
 }
 
+/// The summary line with the CPU time of the whole `umsim` process (what
+/// the user waits for; `umsim bench` reads it).
+pub const PROCESS_CPU_LABEL: &str = "process CPU time       ";
+
 /// Prints the run summary; a closed stdout (`umsim run … | head`) is not an error.
 fn print_summary(s: &RunSummary, output: Option<&std::path::Path>) {
     use std::io::Write;
@@ -267,6 +271,12 @@ fn summary_text(s: &RunSummary, output: Option<&std::path::Path>) -> String {
     say!("Jacobian evaluations   {}", s.jacobian_evaluations);
     say!("equation evaluations   {}", s.dynamics_evaluations);
     say!("CPU time               {:.4} s", s.cpu_time);
+    if let Ok(process) = cpu_time::ProcessTime::try_now() {
+        say!(
+            "{PROCESS_CPU_LABEL}{:.4} s (start-up, run and output so far)",
+            process.as_duration().as_secs_f64()
+        );
+    }
     say!("real-time factor       {:.2}", s.realtime_factor());
     if s.steps > 0 {
         say!(

@@ -25,6 +25,7 @@ use crate::forces::{
     add_generalized_force,
 };
 use crate::model_system::ModelSystem;
+use crate::run::CpuClock;
 use crate::run::assessment::LoadSample;
 use crate::run::columns::{ARC_COLUMNS, Columns, arc_motion, columns};
 use crate::run::grid::Row;
@@ -38,7 +39,6 @@ use nalgebra::{DMatrix, DVector};
 use railmbs_models::{BodyRef, Expr, Frame, Model, TrainCoupler, TrainScenario};
 use std::ops::Range;
 use std::path::Path;
-use std::time::Instant;
 
 /// A coupler between body `bodies[0]` of vehicle `vehicles[0]` and body
 /// `bodies[1]` of vehicle `vehicles[1]`: a [`Linear6`] element whose two
@@ -666,7 +666,7 @@ pub fn run_train_into(
         interval: train.output.interval,
     };
     let mut summary = RunSummary::new(names.join("+"));
-    let start = Instant::now();
+    let start = CpuClock::start();
     // Each vehicle keeps its bodies' absolute velocities across a kink.
     let (rows, last_step, assessment) = runner.run(
         &mut system,
@@ -691,7 +691,7 @@ pub fn run_train_into(
             Ok(out)
         },
     )?;
-    let cpu_time = start.elapsed().as_secs_f64();
+    let cpu_time = start.seconds();
     summary.finish(cpu_time, rows, last_step, assessment);
     Ok(summary)
 }

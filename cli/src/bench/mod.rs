@@ -8,7 +8,10 @@
 //!   Jacobians and the projection of the force elements' wrenches), ns;
 //! - **run**: the whole default scenario (or `--scenario`) by `run_scenario`
 //!   with no CSV written (integration and output interpolation; the system
-//!   setup is included and small), s.
+//!   setup is included and small), s;
+//! - **whole process**: the CPU time of a whole `umsim run SCENARIO` process
+//!   with its CSV ([`process`]), what a user waits for: start-up (plugin and
+//!   contact tables found in their caches), run and output, s.
 //!
 //! Timing method ([`timing`]): a batch repeats the evaluation over the states,
 //! its length is doubled until one batch takes at least [`BATCH_SECONDS`];
@@ -47,6 +50,7 @@
 //! [`report`] (the table and the JSON).
 
 mod model;
+pub mod process;
 pub mod report;
 pub mod timing;
 mod train;

@@ -2,6 +2,7 @@
 //! each engine, and its scenario (`--scenario`, or the default one found
 //! beside the model) run with each engine.
 
+use super::process::whole_process;
 use super::report::{BenchReport, EngineTimes};
 use super::timing::median_run;
 use super::workload::{MakeEngine, random_states, run_scenario_once, time_engine};
@@ -135,6 +136,7 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
             }
             Err(e) => numeric.note = Some(e),
         }
+        whole_process(&s.source, Engine::Numeric, args, &mut numeric);
     }
 
     let mut symbolic = EngineTimes::default();
@@ -175,6 +177,7 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
                         }
                         Err(e) => symbolic.note = Some(e),
                     }
+                    whole_process(&s.source, Engine::Symbolic, args, &mut symbolic);
                 }
             }
         }

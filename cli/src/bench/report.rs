@@ -14,6 +14,9 @@ pub struct EngineTimes {
     pub run_s: Option<f64>,
     /// Integration steps of the scenario run.
     pub run_steps: Option<usize>,
+    /// CPU time of a whole `umsim run` process of the scenario, caches warm
+    /// (start-up, run, CSV output), s.
+    pub process_s: Option<f64>,
     /// Why something is missing.
     pub note: Option<String>,
 }
@@ -91,6 +94,8 @@ impl BenchReport {
             "symbolic_run_s": self.symbolic.run_s,
             "run_ratio": self.run_ratio(),
             "numeric_run_steps": self.numeric.run_steps,
+            "numeric_process_s": self.numeric.process_s,
+            "symbolic_process_s": self.symbolic.process_s,
             "symbolic_run_steps": self.symbolic.run_steps,
             "creep": self.creep,
             "derive_s": self.derive_s,
@@ -155,6 +160,12 @@ impl BenchReport {
                 sec(self.numeric.run_s),
                 sec(self.symbolic.run_s),
                 r(self.run_ratio()),
+            ),
+            (
+                "whole umsim run process",
+                sec(self.numeric.process_s),
+                sec(self.symbolic.process_s),
+                r(ratio(self.numeric.process_s, self.symbolic.process_s)),
             ),
             (
                 "steps of the run",

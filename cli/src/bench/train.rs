@@ -3,6 +3,7 @@
 //! vehicles), and the whole train scenario run by `run_train` with every
 //! vehicle on the same engine.
 
+use super::process::whole_process;
 use super::report::{BenchReport, EngineTimes};
 use super::timing::{Stopwatch, median_run};
 use super::workload::{random_states, time_engine};
@@ -123,6 +124,7 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
     })?;
     numeric.run_s = Some(t);
     numeric.run_steps = Some(n);
+    whole_process(&train.source, Engine::Numeric, args, &mut numeric);
     if args.engine == BenchEngine::Numeric {
         symbolic.note = Some("not requested (--engine numeric)".into());
         (derive_s, compile_s) = (None, None);
@@ -134,6 +136,7 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
         })?;
         symbolic.run_s = Some(t);
         symbolic.run_steps = Some(n);
+        whole_process(&train.source, Engine::Symbolic, args, &mut symbolic);
     } else {
         (derive_s, compile_s) = (None, None);
     }

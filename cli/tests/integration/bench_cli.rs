@@ -13,7 +13,7 @@ fn json(o: &Output) -> serde_json::Value {
     serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}):\n{stdout}"))
 }
 
-const KEYS: [&str; 10] = [
+const KEYS: [&str; 12] = [
     "model",
     "dof",
     "numeric_eval_ns",
@@ -22,6 +22,8 @@ const KEYS: [&str; 10] = [
     "numeric_run_s",
     "symbolic_run_s",
     "run_ratio",
+    "numeric_process_s",
+    "symbolic_process_s",
     "derive_s",
     "compile_s",
 ];
@@ -50,6 +52,8 @@ fn bench_json_has_the_documented_keys() {
     assert_eq!(v["dof"], 3);
     positive(&v, "numeric_eval_ns");
     positive(&v, "numeric_run_s");
+    // The whole `umsim run` process of the scenario, measured in a child.
+    positive(&v, "numeric_process_s");
     // models/scenarios/chain3_rk4.ron is the default scenario of chain3.
     assert!(
         v["scenario"].as_str().unwrap().ends_with("chain3_rk4.ron"),
@@ -69,6 +73,7 @@ fn bench_json_has_the_documented_keys() {
         assert!((ratio - expect).abs() <= 1e-12 * expect);
         positive(&v, "symbolic_run_s");
         positive(&v, "run_ratio");
+        positive(&v, "symbolic_process_s");
     }
 }
 
