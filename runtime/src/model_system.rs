@@ -340,7 +340,7 @@ impl MechanicalSystem for ModelSystem {
             mass.copy_from(&self.eval.mass);
         } else {
             // Element states have no inertia: zero rows and columns.
-            mass.fill(0.0);
+            mass.as_mut_slice().fill(0.0);
             mass.view_mut((0, 0), (n, n)).copy_from(&self.eval.mass);
         }
         Ok(())
@@ -370,7 +370,7 @@ impl MechanicalSystem for ModelSystem {
         if self.states.is_empty() {
             jacobian.copy_from(&self.eval.constraint_jacobian);
         } else {
-            jacobian.fill(0.0);
+            jacobian.as_mut_slice().fill(0.0);
             let (nc, n) = self.eval.constraint_jacobian.shape();
             jacobian
                 .view_mut((0, 0), (nc, n))
@@ -406,8 +406,8 @@ impl MechanicalSystem for ModelSystem {
         };
         let (q, v) = self.take_states(q, v);
         self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
-        dfdq.fill(0.0);
-        dfdv.fill(0.0);
+        dfdq.as_mut_slice().fill(0.0);
+        dfdv.as_mut_slice().fill(0.0);
         let ctx = ForceContext {
             t,
             bodies: &self.eval.bodies,

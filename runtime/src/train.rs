@@ -309,7 +309,7 @@ impl MechanicalSystem for TrainSystem {
         mass: &mut DMatrix<f64>,
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
-        mass.fill(0.0);
+        mass.as_mut_slice().fill(0.0);
         for (k, s) in self.vehicles.iter_mut().enumerate() {
             let r = self.ranges[k].clone();
             s.dynamics(
@@ -354,7 +354,7 @@ impl MechanicalSystem for TrainSystem {
         g: &mut DVector<f64>,
         jacobian: &mut DMatrix<f64>,
     ) -> Result<(), SimError> {
-        jacobian.fill(0.0);
+        jacobian.as_mut_slice().fill(0.0);
         for (k, s) in self.vehicles.iter_mut().enumerate() {
             let (r, c) = (self.ranges[k].clone(), self.constraint_ranges[k].clone());
             if c.is_empty() {
@@ -382,8 +382,8 @@ impl MechanicalSystem for TrainSystem {
         dfdq: &mut DMatrix<f64>,
         dfdv: &mut DMatrix<f64>,
     ) -> Result<bool, SimError> {
-        dfdq.fill(0.0);
-        dfdv.fill(0.0);
+        dfdq.as_mut_slice().fill(0.0);
+        dfdv.as_mut_slice().fill(0.0);
         for (k, s) in self.vehicles.iter_mut().enumerate() {
             let r = self.ranges[k].clone();
             if !s.force_jacobian(
