@@ -514,6 +514,128 @@ struct Figure<'a> {
     width: u32,
 }
 
+/// Legend layout in pixels (plotters' series-label box: a margin around the
+/// sample lines and the labels, one row per series).
+const LEGEND_MARGIN: u32 = 8;
+const LEGEND_LINE: u32 = 28;
+const LEGEND_ROW: u32 = 16;
+/// Distance of plotters' legend box from the plotting area's edges, px.
+const LEGEND_INSET: f64 = 5.0;
+
+/// A legend box of `size` pixels with its upper left corner at `at` on
+/// `area`, drawn like plotters' series labels: a sample line and the label
+/// per series, in order.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    size: (f64, f64),
+    labels: &[(&str, RGBColor)],
+    style: &TextStyle,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (x, y) = at;
+    let corner = (x + size.0 as i32, y + size.1 as i32);
+    area.draw(&Rectangle::new([at, corner], WHITE.mix(0.85).filled()))?;
+    area.draw(&Rectangle::new([at, corner], RGBColor(160, 160, 160)))?;
+    let m = LEGEND_MARGIN as i32;
+    for (row, (label, colour)) in labels.iter().enumerate() {
+        let mid = y + m + (row as i32) * LEGEND_ROW as i32 + LEGEND_ROW as i32 / 2;
+        area.draw(&PathElement::new(
+            vec![(x + m, mid), (x + m + 20, mid)],
+            colour.stroke_width(2),
+        ))?;
+        let text = style.pos(plotters::style::text_anchor::Pos::new(
+            HPos::Left,
+            VPos::Center,
+        ));
+        area.draw(&Text::new(
+            label.to_string(),
+            (x + m + LEGEND_LINE as i32, mid),
+            text,
+        ))?;
+    }
+    Ok(())
+}
+
+/// Where a legend of `legend_px` (w, h) pixels hides none of the `parts`
+/// (per series, its polylines) on a plotting area of `plot_px` pixels for
+/// the ranges `x` and `y`: the first free corner (upper right, upper left,
+/// lower right, lower left), else the upper right with the top of the y
+/// range raised so that the data stays below the legend. Returns the corner
+/// and the (possibly raised) top of the y range.
+pub fn place_legend(
+    parts: &[Vec<Vec<(f64, f64)>>],
+    x: (f64, f64),
+    y: (f64, f64),
+    plot_px: (f64, f64),
+    legend_px: (f64, f64),
+) -> (SeriesLabelPosition, f64) {
+    let (w, h) = plot_px;
+    let (lw, lh) = (legend_px.0 + 2.0, legend_px.1 + 2.0);
+    let to_px =
+        |(px, py): (f64, f64), y1: f64| ((px - x.0) / (x.1 - x.0) * w, (y1 - py) / (y1 - y.0) * h);
+    let corners = [
+        (
+            SeriesLabelPosition::UpperRight,
+            w - lw - LEGEND_INSET,
+            LEGEND_INSET,
+        ),
+        (SeriesLabelPosition::UpperLeft, LEGEND_INSET, LEGEND_INSET),
+        (
+            SeriesLabelPosition::LowerRight,
+            w - lw - LEGEND_INSET,
+            h - lh - LEGEND_INSET,
+        ),
+        (
+            SeriesLabelPosition::LowerLeft,
+            LEGEND_INSET,
+            h - lh - LEGEND_INSET,
+        ),
+    ];
+    if lw + 2.0 * LEGEND_INSET < w && lh + 2.0 * LEGEND_INSET < h {
+        for (corner, bx, by) in corners {
+            let hidden = parts.iter().flatten().any(|line| {
+                let pts: Vec<(f64, f64)> = line.iter().map(|&p| to_px(p, y.1)).collect();
+                crosses_box(&pts, (bx, by), (bx + lw, by + lh))
+            });
+            if !hidden {
+                return (corner, y.1);
+            }
+        }
+    }
+    // Raise the top so that the data fills only the height below the legend.
+    let free = (h - lh - 2.0 * LEGEND_INSET).max(0.25 * h);
+    let y1 = y.0 + (y.1 - y.0) * h / free;
+    (SeriesLabelPosition::UpperRight, y1)
+}
+
+/// Whether the polyline `pts` (pixels) has a point in, or a segment through,
+/// the box from `lo` to `hi`.
+pub fn crosses_box(pts: &[(f64, f64)], lo: (f64, f64), hi: (f64, f64)) -> bool {
+    let inside = |(x, y): (f64, f64)| x >= lo.0 && x <= hi.0 && y >= lo.1 && y <= hi.1;
+    if pts.iter().any(|&p| inside(p)) {
+        return true;
+    }
+    pts.windows(2).any(|s| {
+        let ((xa, ya), (xb, yb)) = (s[0], s[1]);
+        // The segment's part within the box's columns, then its rows.
+        let (t0, t1) = if (xb - xa).abs() < 1e-12 {
+            if xa < lo.0 || xa > hi.0 {
+                return false;
+            }
+            (0.0, 1.0)
+        } else {
+            let ta = (lo.0 - xa) / (xb - xa);
+            let tb = (hi.0 - xa) / (xb - xa);
+            (ta.min(tb).max(0.0), ta.max(tb).min(1.0))
+        };
+        if t0 > t1 {
+            return false;
+        }
+        let (y0, y1) = (ya + t0 * (yb - ya), ya + t1 * (yb - ya));
+        y0.max(y1) >= lo.1 && y0.min(y1) <= hi.1
+    })
+}
+
 const FONT: &str = "sans-serif";
 
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String>
@@ -535,7 +657,33 @@ where
     let areas = area.split_by_breakpoints([] as [u32; 0], breaks);
     let (x0, x1) = fig.x_range;
     let x_fmt = tick_format(x0, x1, 10);
+    // Legend sizes (w, h) in pixels. A legend taller than a third of its
+    // panel would squeeze the data: then every panel's legend goes to the
+    // right of the plotting areas, which keep one width (and one x axis).
+    let label_style = TextStyle::from((FONT, 12));
+    let mut legends = Vec::with_capacity(fig.panels.len());
+    for panel in fig.panels {
+        let mut text_w = 0u32;
+        for &k in &panel.columns {
+            let (w, _) = area
+                .estimate_text_size(&fig.header[k], &label_style)
+                .map_err(err)?;
+            text_w = text_w.max(w);
+        }
+        legends.push((
+            f64::from(text_w + LEGEND_LINE + 2 * LEGEND_MARGIN),
+            f64::from(LEGEND_ROW * panel.columns.len() as u32 + 2 * LEGEND_MARGIN),
+        ));
+    }
+    let panel_h = f64::from(plot_h.saturating_sub(top + x_axis));
+    let outside = legends.iter().any(|l| l.1 > panel_h / 3.0);
+    let right = if outside {
+        legends.iter().map(|l| l.0 as u32).max().unwrap_or(0) + 2 * LEGEND_INSET as u32 + 20
+    } else {
+        20
+    };
     for (p, (panel, sub)) in fig.panels.iter().zip(&areas).enumerate() {
+        let legend_px = legends[p];
         let last = p + 1 == fig.panels.len();
         let values = || {
             panel
@@ -558,11 +706,33 @@ where
             }
             size -= 1.0;
         }
+        let parts: Vec<Vec<Vec<(f64, f64)>>> = panel
+            .columns
+            .iter()
+            .map(|k| {
+                let ys = fig.table.columns.get(k).unwrap_or(&fig.table.x);
+                segments(&fig.table.x, ys, x0, x1, fig.width)
+            })
+            .collect();
+        // The legend goes into a corner of the plotting area where it hides
+        // no data; if every corner has some, the y range grows upwards to
+        // make room above the data.
+        let x_label_area = if last { x_axis - 8 } else { 0 };
+        let (sub_w, sub_h) = sub.dim_in_pixel();
+        let plot_px = (
+            f64::from(sub_w.saturating_sub(8 + right + 92)),
+            f64::from(sub_h.saturating_sub(top + x_label_area)),
+        );
+        let (legend, y1) = if outside {
+            (SeriesLabelPosition::UpperRight, y1)
+        } else {
+            place_legend(&parts, (x0, x1), (y0, y1), plot_px, legend_px)
+        };
         let mut chart = ChartBuilder::on(sub)
             .margin_top(top)
-            .margin_right(20)
+            .margin_right(right)
             .margin_left(8)
-            .x_label_area_size(if last { x_axis - 8 } else { 0 })
+            .x_label_area_size(x_label_area)
             .y_label_area_size(92)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(err)?;
@@ -579,10 +749,8 @@ where
             mesh.x_desc(fig.x_label);
         }
         mesh.draw().map_err(err)?;
-        for (c, &k) in panel.columns.iter().enumerate() {
+        for (c, (&k, parts)) in panel.columns.iter().zip(&parts).enumerate() {
             let colour = COLOURS[c % COLOURS.len()];
-            let ys = fig.table.columns.get(&k).unwrap_or(&fig.table.x);
-            let parts = segments(&fig.table.x, ys, x0, x1, fig.width);
             let style = colour.stroke_width(2);
             let name = if parts.is_empty() {
                 format!("{} (no data)", fig.header[k])
@@ -611,9 +779,22 @@ where
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
             }
         }
+        if outside {
+            let labels: Vec<(&str, RGBColor)> = panel
+                .columns
+                .iter()
+                .enumerate()
+                .map(|(c, &k)| (fig.header[k].as_str(), COLOURS[c % COLOURS.len()]))
+                .collect();
+            let x = sub_w as i32 - legend_px.0 as i32 - LEGEND_INSET as i32;
+            draw_legend(sub, (x, top as i32), legend_px, &labels, &label_style).map_err(err)?;
+            continue;
+        }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend)
+            .margin(LEGEND_MARGIN)
+            .legend_area_size(LEGEND_LINE)
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(160, 160, 160))
             .label_font((FONT, 12))
@@ -685,6 +866,29 @@ impl DrawingBackend for Png<'_> {
         fill: bool,
     ) -> Result<(), PngError> {
         self.inner.draw_rect(upper_left, bottom_right, style, fill)
+    }
+    /// Thick lines segment by segment with round joints: plotters' bitmap
+    /// backend polygonizes a whole path with mitred joints, which shoot far
+    /// past the data (and out of the panel) where a line turns back sharply,
+    /// as thinned data with its per-pixel minima and maxima does.
+    fn draw_path<S: plotters_backend::BackendStyle, I: IntoIterator<Item = BackendCoord>>(
+        &mut self,
+        path: I,
+        style: &S,
+    ) -> Result<(), PngError> {
+        let width = style.stroke_width();
+        if width <= 1 {
+            return self.inner.draw_path(path, style);
+        }
+        let points: Vec<BackendCoord> = path.into_iter().collect();
+        for pair in points.windows(2) {
+            self.inner.draw_path(pair.iter().copied(), style)?;
+        }
+        let color = style.color();
+        for &p in points.iter().skip(1).take(points.len().saturating_sub(2)) {
+            self.inner.draw_circle(p, width / 2, &color, true)?;
+        }
+        Ok(())
     }
     fn blit_bitmap(
         &mut self,

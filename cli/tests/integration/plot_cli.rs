@@ -325,3 +325,103 @@ fn help_documents_the_subcommand() {
         assert!(help.contains(word), "{word} in {help}");
     }
 }
+
+/// The pixels of `colour` in a PNG: (column, row) of each.
+fn pixels_of(path: &Path, colour: [u8; 3]) -> Vec<(u32, u32)> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    let mut out = Vec::new();
+    for row in 0..info.height {
+        for col in 0..info.width {
+            let i = (row * info.width + col) as usize * channels;
+            if buf[i..i + 3] == colour {
+                out.push((col, row));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn png_lines_stay_inside_their_panel_where_the_data_turns_back_sharply() {
+    // 20 000 rows on 600 px (thinned to each pixel column's first, lowest,
+    // highest and last point) of a smooth wave with one-row spikes, as the
+    // wheel forces of a vehicle run in a switch: thick lines with mitred
+    // joints (how plotters' bitmap backend draws a path) shoot far out of the
+    // panel where the thinned line turns back sharply.
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("time,zig[m]\n");
+    for i in 0..20_000 {
+        let t = f64::from(i) * 1e-4;
+        let spike = if i % 997 == 0 {
+            -0.8
+        } else if i % 1499 == 0 {
+            0.8
+        } else {
+            0.0
+        };
+        text += &format!("{t},{}\n", 0.2 * (20.0 * t).sin() + spike);
+    }
+    let csv = dir.path().join("zig.csv");
+    std::fs::write(&csv, text).unwrap();
+    let png = dir.path().join("zig.png");
+    ok(&[
+        "plot",
+        csv.to_str().unwrap(),
+        "--y",
+        "zig[m]",
+        "--width",
+        "600",
+        "--height",
+        "300",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let blue = pixels_of(&png, [31, 119, 180]);
+    assert!(!blue.is_empty(), "the series is drawn");
+    // The panel: 8 px top margin, 40 px x-axis area at the bottom; the data
+    // (±1 with 5 % padding) lies inside, the line's 1 px half-width beyond
+    // it at most.
+    let (top, bottom) = (8, 300 - 40);
+    let rows = (
+        blue.iter().map(|p| p.1).min().unwrap(),
+        blue.iter().map(|p| p.1).max().unwrap(),
+    );
+    assert!(
+        rows.0 >= top && rows.1 <= bottom,
+        "line rows {rows:?} outside {top}..={bottom}"
+    );
+}
+
+#[test]
+fn legends_go_where_they_hide_no_data() {
+    use plotters::prelude::SeriesLabelPosition;
+    use railmbs_cli::plot::place_legend;
+    let (plot, legend) = ((800.0, 300.0), (200.0, 60.0));
+    // A line along the top right: the legend goes to the upper left.
+    let top_right = vec![vec![vec![(0.5, 0.95), (1.0, 0.95)]]];
+    let (corner, y1) = place_legend(&top_right, (0.0, 1.0), (0.0, 1.0), plot, legend);
+    assert_eq!(corner, SeriesLabelPosition::UpperLeft);
+    assert_eq!(y1, 1.0);
+    // A diagonal from lower left to upper right leaves the other two corners.
+    let diagonal = vec![vec![vec![(0.0, 0.0), (1.0, 1.0)]]];
+    let (corner, _) = place_legend(&diagonal, (0.0, 1.0), (0.0, 1.0), plot, legend);
+    assert_eq!(corner, SeriesLabelPosition::UpperLeft);
+    // Two horizontal lines near the top and the bottom (rows 30 and 270 of
+    // 300) cover every corner: the y range grows until the data ends below
+    // the legend (its height and a 5 px inset).
+    let both = vec![
+        vec![vec![(0.0, 0.9), (1.0, 0.9)]],
+        vec![vec![(0.0, 0.1), (1.0, 0.1)]],
+    ];
+    let (corner, y1) = place_legend(&both, (0.0, 1.0), (0.0, 1.0), plot, legend);
+    assert_eq!(corner, SeriesLabelPosition::UpperRight);
+    let data_top_px = (y1 - 0.9) / y1 * plot.1;
+    assert!(
+        data_top_px >= legend.1 + 5.0,
+        "data top at {data_top_px} px, y1 = {y1}"
+    );
+}
