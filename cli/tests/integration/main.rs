@@ -8,3 +8,4 @@ mod creep_cli;
 mod info_cli;
 mod plot_cli;
 mod run_cli;
+mod study_cli;
