@@ -156,3 +156,94 @@ fn the_bundled_example_study_runs() {
         assert!(yq > 0.0 && yq < limit, "{yq} against {limit}");
     }
 }
+
+/// Starts `umsim study` on an 8-case study whose cases take a few tenths of
+/// a second each, waits for its first row in results.csv and sends it
+/// `signal`; returns the rows recorded then and the process's output.
+fn interrupt_after_first_row(dir: &Path, signal: &str) -> (usize, std::process::Output) {
+    let scenario = railmbs_testkit::model_path("scenarios/spring_mass.ron");
+    let study = dir.join("long.ron");
+    // 2000 s at steps of at most 0.01 s: 200 000 steps per case.
+    std::fs::write(
+        &study,
+        format!(
+            r#"Study(scenario: "{}", engine: Numeric, end_time: Some(2000.0),
+                     cases: Grid({{ "k": [100, 110, 120, 130, 140, 150, 160, 170] }}),
+                     reductions: [Max(column: "z")])"#,
+            scenario.display()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let args = [
+        "study",
+        study.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-j",
+        "1",
+    ];
+    let child = Command::new(env!("CARGO_BIN_EXE_umsim"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let results = out.join("results.csv");
+    let rows = || {
+        std::fs::read_to_string(&results)
+            .map(|t| t.lines().count().saturating_sub(1))
+            .unwrap_or(0)
+    };
+    while rows() == 0 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let kill = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let output = child.wait_with_output().unwrap();
+    (rows(), output)
+}
+
+#[test]
+fn an_interrupted_or_killed_study_resumes_where_it_stopped() {
+    for signal in ["-INT", "-KILL"] {
+        let dir = tempfile::tempdir().unwrap();
+        let (_, o) = interrupt_after_first_row(dir.path(), signal);
+        let results = dir.path().join("out/results.csv");
+        let kept = column(&results, "case_id").len();
+        assert!((1..8).contains(&kept), "{signal}: {kept} rows kept");
+        if signal == "-INT" {
+            // Ctrl-C: the running case stops at its next row, the message
+            // says how many cases are in the table.
+            assert_eq!(o.status.code(), Some(1));
+            let said = text(&o.stderr);
+            assert!(
+                said.contains(&format!("interrupted: {kept} of 8 cases")),
+                "{said}"
+            );
+        }
+        let study = dir.path().join("long.ron");
+        let o = umsim(&[
+            "study",
+            study.to_str().unwrap(),
+            "-o",
+            dir.path().join("out").to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let said = text(&o.stdout);
+        assert!(
+            said.contains(&format!(
+                "{} cases run (0 failed), {kept} skipped",
+                8 - kept
+            )),
+            "{signal}: {said}"
+        );
+        let mut ids = column(&results, "case_id");
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), 8, "{signal}: every case once");
+    }
+}
