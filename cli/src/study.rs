@@ -24,13 +24,13 @@ pub struct Args {
     #[arg(long, short = 'j', default_value_t = 0)]
     pub jobs: usize,
     /// Output folder: results.csv, cases/ (per-case files), series/ (time
-    /// series). Default: out/<study file name without .ron>.
+    /// series). Default: out/NAME, NAME the study file name without .ron.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// List the cases (index, id, inputs) and exit.
     #[arg(long, conflicts_with_all = ["case", "collect"])]
     pub list: bool,
-    /// Run only the case INDEX (0-based) and write DIR/cases/<id>.csv; without
+    /// Run only the case INDEX (0-based) and write DIR/cases/ID.csv (ID the case id); without
     /// INDEX, the index is $SLURM_ARRAY_TASK_ID (a Slurm job array
     /// `--array=0-N`). A case whose file exists is not run again.
     #[arg(long, value_name = "INDEX", num_args = 0..=1, conflicts_with = "collect")]

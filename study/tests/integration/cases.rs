@@ -117,3 +117,43 @@ fn a_latin_hypercube_has_one_sample_in_every_stratum_of_every_range() {
     let other = load(dir.path(), &text(8));
     assert_ne!(numbers(&other.cases()[0]), numbers(&study.cases()[0]));
 }
+
+#[test]
+fn the_crate_docs_example_study_loads_with_the_cases_it_describes() {
+    let docs = std::fs::read_to_string(railmbs_testkit::repo_path("study/src/lib.rs")).unwrap();
+    let start = docs.find("//! ```ron\n").unwrap() + "//! ```ron\n".len();
+    let end = start + docs[start..].find("//! ```\n").unwrap();
+    let text: String = docs[start..end]
+        .lines()
+        .map(|l| {
+            l.strip_prefix("//!")
+                .unwrap_or(l)
+                .strip_prefix(' ')
+                .unwrap_or("")
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    // As if it were a file of models/studies (its scenario path is relative).
+    let path = railmbs_testkit::model_path("studies/docs_example.ron");
+    let study = railmbs_study::Study::parse(&text, &path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(study.cases().len(), 4);
+    let c = &study.cases()[1];
+    assert_eq!(c.input_texts(), ["15000000", "6"]);
+    assert_eq!(c.overrides.speed, Some(6.0));
+    assert_eq!(c.overrides.end_time, Some(3.0));
+    let set: Vec<(&str, &str)> = c
+        .overrides
+        .parameters
+        .iter()
+        .map(|(a, b)| (a.as_str(), b.as_str()))
+        .collect();
+    assert_eq!(
+        set,
+        [
+            ("Bogie1.kx", "(15000000)"),
+            ("Bogie2.kx", "(15000000)"),
+            ("v0", "(6)")
+        ]
+    );
+    assert_eq!(study.reductions.len(), 3);
+}
