@@ -105,8 +105,13 @@ fn engine(args: &Args, study: &Study) -> Result<StudyEngine, StudyError> {
     let terminal = !args.quiet && std::io::stderr().is_terminal();
     if terminal && study.engine == railmbs_study::EngineKind::Symbolic {
         eprint!(
-            "umsim: symbolic equations of model \"{}\": deriving, then compiling unless cached…",
-            study.model.name
+            "umsim: symbolic equations of model {}: deriving, then compiling unless cached…",
+            study
+                .models
+                .iter()
+                .map(|m| format!("\"{}\"", m.name))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     let start = Instant::now();

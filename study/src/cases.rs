@@ -1,9 +1,9 @@
 //! The cases of a study: generation (grid, list, table, Latin hypercube),
 //! resolution into scenario overrides, canonical text and id.
 
-use crate::format::{Problems, Study, value_text};
+use crate::format::{Problems, Study, StudyScenario, value_text};
 use railmbs_models::syntax::{OrderedMap, Value};
-use railmbs_models::{Model, ModelError, Scenario};
+use railmbs_models::{Model, ModelError};
 use std::path::Path;
 
 /// Reserved variable: the running speed, m/s.
@@ -41,20 +41,34 @@ impl Overrides {
     /// # Errors
     /// An end time the scenario's limits refuse, or a speed for a scenario
     /// that has none to set.
-    pub fn apply(&self, scenario: &Scenario) -> Result<Scenario, String> {
+    pub fn apply(&self, scenario: &StudyScenario) -> Result<StudyScenario, String> {
         let mut s = scenario.clone();
         for (name, value) in &self.parameters {
             s.set_parameter(name, value);
         }
-        s.macros.extend(self.macros.iter().cloned());
         if let Some(t) = self.end_time {
             s.set_end_time(t).map_err(|e| format!("end time: {e}"))?;
         }
-        if let Some(v) = self.speed {
-            match &mut s.track {
-                Some(track) if track.speed_profile.is_empty() => track.speed = v,
-                _ => {
-                    return Err("@speed needs a scenario on a track at constant speed".into());
+        let no_speed = || "@speed needs a scenario on a track at constant speed".to_string();
+        match &mut s {
+            StudyScenario::Single(single) => {
+                single.macros.extend(self.macros.iter().cloned());
+                if let Some(v) = self.speed {
+                    match &mut single.track {
+                        Some(track) if track.speed_profile.is_empty() => track.speed = v,
+                        _ => return Err(no_speed()),
+                    }
+                }
+            }
+            StudyScenario::Train(train) => {
+                if !self.macros.is_empty() {
+                    return Err("@macro needs a single-vehicle scenario".into());
+                }
+                if let Some(v) = self.speed {
+                    if !train.track.speed_profile.is_empty() {
+                        return Err(no_speed());
+                    }
+                    train.track.speed = v;
                 }
             }
         }
@@ -371,11 +385,16 @@ fn substitute(template: &str, variables: &[String], values: &[Value]) -> String 
 pub(crate) fn check_variables(
     variables: &[String],
     set: &[(String, String)],
-    model: &Model,
-    scenario: &Scenario,
+    models: &[Model],
+    scenario: &StudyScenario,
     p: &mut Problems,
 ) {
-    let is_parameter = |n: &str| model.parameters.iter().any(|q| q.name == n);
+    let is_parameter = |n: &str| models.iter().any(|m| m.parameter_index(n).is_some());
+    let model_names = models
+        .iter()
+        .map(|m| format!("\"{}\"", m.name))
+        .collect::<Vec<_>>()
+        .join(", ");
     for (k, name) in variables.iter().enumerate() {
         if variables[..k].contains(name) {
             p.at(
@@ -390,22 +409,25 @@ pub(crate) fn check_variables(
             .any(|(_, t)| template_names(t).contains(&name.as_str()));
         match name.as_str() {
             SPEED => {
-                let constant = scenario
-                    .track
-                    .as_ref()
-                    .is_some_and(|t| t.speed_profile.is_empty());
-                if !constant {
+                if !scenario.constant_speed() {
                     p.at(
                         Some(name),
                         "cases",
                         &format!("variable \"{name}\""),
                         format!(
                             "the scenario {} does not run on a track at constant speed",
-                            scenario.source.display()
+                            scenario.source().display()
                         ),
                     );
                 }
             }
+            MACRO if matches!(scenario, StudyScenario::Train(_)) => p.at(
+                Some(name),
+                "cases",
+                &format!("variable \"{name}\""),
+                "a train's vehicles have their own macros; @macro needs a single-vehicle scenario"
+                    .into(),
+            ),
             END_TIME | MACRO => {}
             n if n.starts_with('@') => p.at(
                 Some(name),
@@ -419,9 +441,8 @@ pub(crate) fn check_variables(
                 "cases",
                 &format!("variable \"{name}\""),
                 format!(
-                    "neither a parameter of model \"{}\", nor a reserved name ({SPEED}, \
-                     {END_TIME}, {MACRO}), nor used as {{{name}}} in `set`",
-                    model.name
+                    "neither a parameter of model {model_names}, nor a reserved name ({SPEED}, \
+                     {END_TIME}, {MACRO}), nor used as {{{name}}} in `set`"
                 ),
             ),
         }
@@ -486,19 +507,19 @@ pub(crate) fn resolve(study: &Study, rows: Vec<RawRow>, p: &mut Problems) -> Vec
                 },
                 MACRO => match value {
                     Value::Text(m) if m.is_empty() => {}
-                    Value::Text(m) if study.model.macros.iter().any(|x| &x.name == m) => {
+                    Value::Text(m) if study.models[0].macros.iter().any(|x| &x.name == m) => {
                         o.macros.push(m.clone());
                     }
                     _ => fail(
                         p,
                         format!(
                             "{MACRO}: model \"{}\" has no macro \"{}\"",
-                            study.model.name,
+                            study.models[0].name,
                             value_text(value)
                         ),
                     ),
                 },
-                n if study.model.parameters.iter().any(|q| q.name == n) => {
+                n if study.has_parameter(n) => {
                     if number.is_some_and(|x| !x.is_finite()) {
                         fail(p, format!("\"{n}\" is not finite"));
                     }

@@ -1,9 +1,10 @@
 //! The engine of a study: the model's plugin, built and loaded once, and the
 //! run of one case to a result row.
 
-use crate::format::{EngineKind, Study};
+use crate::format::{EngineKind, Study, StudyScenario};
 use crate::reduce::{CaseReducer, Cell};
 use crate::{Case, StudyError};
+use railmbs_models::Model;
 use railmbs_runtime::forces::ContactTableCache;
 use railmbs_runtime::run::{CsvFile, Interruptible, OutputSink, RunError, run_scenario_with};
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
@@ -31,7 +32,8 @@ pub struct PluginBuilds {
 #[derive(Debug)]
 pub struct StudyEngine {
     kind: EngineKind,
-    plugin: Option<Plugin>,
+    /// One per model of the study (symbolic), none (numeric).
+    plugins: Vec<Plugin>,
     builds: PluginBuilds,
     /// The wheel–rail contact tables, built by the first case that needs
     /// them and shared by the others (same model and track).
@@ -130,75 +132,100 @@ fn thread_cpu() -> Option<cpu_time::ThreadTime> {
 }
 
 impl StudyEngine {
-    /// The engine of `study`: for a symbolic study, derives the model's
-    /// equations and builds the plugin through the cache (`cache_dir`, else
-    /// `RAILMBS_CACHE_DIR`, else the platform cache directory) and loads it.
+    /// The engine of `study`: for a symbolic study, derives the equations of
+    /// each of its models (one; a train's distinct model files) and builds
+    /// the plugin through the cache (`cache_dir`, else `RAILMBS_CACHE_DIR`,
+    /// else the platform cache directory) and loads it.
     ///
     /// # Errors
-    /// [`StudyError::Plugin`] when the plugin cannot be built or loaded.
+    /// [`StudyError::Plugin`] when a plugin cannot be built or loaded.
     pub fn prepare(study: &Study, cache_dir: Option<PathBuf>) -> Result<StudyEngine, StudyError> {
         let mut builds = PluginBuilds::default();
-        let plugin = match study.engine {
-            EngineKind::Numeric => None,
-            EngineKind::Symbolic => {
+        let mut plugins = Vec::new();
+        if study.engine == EngineKind::Symbolic {
+            for model in &study.models {
                 let opts = railmbs_codegen::GenerateOptions::new();
-                let built = railmbs_codegen::build_plugin(&study.model, &opts, cache_dir)
-                    .map_err(|e| plugin_error(study, e))?;
+                let built = railmbs_codegen::build_plugin(model, &opts, cache_dir.clone())
+                    .map_err(|e| plugin_error(model, e))?;
                 builds.derived += 1;
                 builds.compiled += usize::from(!built.cache_hit);
-                let plugin = Plugin::load_for(&built.path, &study.model)
-                    .map_err(|e| plugin_error(study, e))?;
+                let plugin =
+                    Plugin::load_for(&built.path, model).map_err(|e| plugin_error(model, e))?;
                 builds.loaded += 1;
-                Some(plugin)
+                plugins.push(plugin);
             }
-        };
+        }
         Ok(StudyEngine {
             kind: study.engine,
-            plugin,
+            plugins,
             builds,
             tables: ContactTableCache::new(),
         })
     }
 
-    /// The engine of a symbolic `study` on the plugin at `path` (built
-    /// elsewhere, e.g. by the client of a distributed study), checked
-    /// against the study's model.
+    /// The engine of a symbolic `study` on plugins built elsewhere (by the
+    /// client of a distributed study, say): `paths` has one per model of
+    /// [`Study::models`], in order, each checked against its model.
     ///
     /// # Errors
-    /// [`StudyError::Plugin`] when it cannot be loaded or is of another model.
-    pub fn from_plugin(study: &Study, path: &Path) -> Result<StudyEngine, StudyError> {
-        let plugin = Plugin::load_for(path, &study.model).map_err(|e| plugin_error(study, e))?;
+    /// [`StudyError::Plugin`] when one cannot be loaded, is of another
+    /// model, or the number of paths is not the number of models.
+    pub fn from_plugins(study: &Study, paths: &[&Path]) -> Result<StudyEngine, StudyError> {
+        if paths.len() != study.models.len() {
+            return Err(StudyError::Plugin {
+                model: study
+                    .models
+                    .iter()
+                    .map(|m| m.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                message: format!(
+                    "{} plugin file(s) given for {} model(s)",
+                    paths.len(),
+                    study.models.len()
+                ),
+            });
+        }
+        let plugins = study
+            .models
+            .iter()
+            .zip(paths)
+            .map(|(m, p)| Plugin::load_for(p, m).map_err(|e| plugin_error(m, e)))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(StudyEngine {
             kind: EngineKind::Symbolic,
-            plugin: Some(plugin),
             builds: PluginBuilds {
-                loaded: 1,
+                loaded: plugins.len(),
                 ..PluginBuilds::default()
             },
+            plugins,
             tables: ContactTableCache::new(),
         })
     }
 
-    /// The loaded plugin's file (symbolic studies): what a worker on the
-    /// same machine or a shared file system gives [`StudyEngine::from_plugin`].
-    pub fn plugin_path(&self) -> Option<&Path> {
-        self.plugin.as_ref().map(Plugin::path)
+    /// The loaded plugins' files, one per model (symbolic studies): what a
+    /// worker on the same machine or a shared file system gives
+    /// [`StudyEngine::from_plugins`].
+    pub fn plugin_paths(&self) -> Vec<&Path> {
+        self.plugins.iter().map(Plugin::path).collect()
     }
 
-    /// Wheel–rail contact tables built so far (shared by the cases).
+    /// Wheel–rail contact tables built so far (shared by the cases of a
+    /// single-vehicle study; a train's runs build their own).
     pub fn contact_tables(&self) -> usize {
         self.tables.len()
     }
 
-    /// How often this engine derived, compiled and loaded the plugin.
+    /// How often this engine derived, compiled and loaded plugins.
     pub fn builds(&self) -> PluginBuilds {
         self.builds
     }
 
-    fn equations(&self, study: &Study) -> Box<dyn Equations> {
-        match (&self.plugin, self.kind) {
-            (Some(p), _) => Box::new(PluginEquations::new(p.clone())),
-            (None, _) => Box::new(NumericEquations::new(&study.model)),
+    /// A fresh engine state for model `k` of the study.
+    fn equations(&self, study: &Study, k: usize) -> Box<dyn Equations> {
+        match (self.kind, self.plugins.get(k)) {
+            (EngineKind::Symbolic, Some(p)) => Box::new(PluginEquations::new(p.clone())),
+            _ => Box::new(NumericEquations::new(&study.models[k])),
         }
     }
 
@@ -259,15 +286,32 @@ impl StudyEngine {
         let flag = options.stop.clone().unwrap_or_default();
         let run = {
             let mut sink = Interruptible::new(&mut reducer, flag);
-            let equations = self.equations(study);
-            run_scenario_with(
-                &scenario,
-                &study.model,
-                equations,
-                &mut sink,
-                |_| {},
-                &self.tables,
-            )
+            match &scenario {
+                StudyScenario::Single(s) => {
+                    let equations = self.equations(study, 0);
+                    run_scenario_with(
+                        s,
+                        &study.models[0],
+                        equations,
+                        &mut sink,
+                        |_| {},
+                        &self.tables,
+                    )
+                }
+                StudyScenario::Train(t) => {
+                    let models: Vec<&Model> = study
+                        .vehicle_models
+                        .iter()
+                        .map(|&k| &study.models[k])
+                        .collect();
+                    let engines = study
+                        .vehicle_models
+                        .iter()
+                        .map(|&k| self.equations(study, k))
+                        .collect();
+                    railmbs_runtime::train::run_train_into(t, &models, engines, &mut sink, |_| {})
+                }
+            }
         };
         match run {
             Ok(summary) => {
@@ -301,9 +345,9 @@ impl StudyEngine {
     }
 }
 
-fn plugin_error(study: &Study, e: impl std::fmt::Display) -> StudyError {
+fn plugin_error(model: &Model, e: impl std::fmt::Display) -> StudyError {
     StudyError::Plugin {
-        model: study.model.name.clone(),
+        model: model.name.clone(),
         message: e.to_string(),
     }
 }

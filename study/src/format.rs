@@ -3,7 +3,7 @@
 use crate::cases::{self, Case};
 use crate::reduce::{Reduction, ReductionKind, Window};
 use railmbs_models::syntax::{Locator, OrderedMap, Value, ron_error};
-use railmbs_models::{Model, ModelError, ModelErrors, Scenario};
+use railmbs_models::{AnyScenario, Model, ModelError, ModelErrors, Scenario, TrainScenario};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -105,6 +105,55 @@ pub enum CaseSource {
     },
 }
 
+/// The scenario a study's cases start from: one vehicle, or a train.
+#[derive(Debug, Clone)]
+pub enum StudyScenario {
+    /// A `Scenario(...)` file.
+    Single(Scenario),
+    /// A `Train(...)` file (parameters are train-wide: every vehicle whose
+    /// model has them).
+    Train(TrainScenario),
+}
+
+impl StudyScenario {
+    /// The scenario file.
+    pub fn source(&self) -> &Path {
+        match self {
+            StudyScenario::Single(s) => &s.source,
+            StudyScenario::Train(t) => &t.source,
+        }
+    }
+
+    /// Whether it runs on a track at constant speed (so `@speed` can set it).
+    pub fn constant_speed(&self) -> bool {
+        match self {
+            StudyScenario::Single(s) => {
+                s.track.as_ref().is_some_and(|t| t.speed_profile.is_empty())
+            }
+            StudyScenario::Train(t) => t.track.speed_profile.is_empty(),
+        }
+    }
+
+    /// Replaces the end time (s), checked like the file's own.
+    ///
+    /// # Errors
+    /// What is wrong, in one message.
+    pub fn set_end_time(&mut self, t: f64) -> Result<(), String> {
+        match self {
+            StudyScenario::Single(s) => s.set_end_time(t),
+            StudyScenario::Train(tr) => tr.set_end_time(t),
+        }
+    }
+
+    /// Sets a parameter (train-wide for a train) to the expression `value`.
+    pub fn set_parameter(&mut self, name: &str, value: &str) {
+        match self {
+            StudyScenario::Single(s) => s.set_parameter(name, value),
+            StudyScenario::Train(t) => t.set_parameter(name, value),
+        }
+    }
+}
+
 /// A loaded, validated study: its scenario and model, its cases and
 /// reductions.
 #[derive(Debug, Clone)]
@@ -114,9 +163,13 @@ pub struct Study {
     /// The scenario path as written in the study file (part of the case ids).
     pub scenario_text: String,
     /// The scenario every case starts from.
-    pub scenario: Scenario,
-    /// The scenario's model (one for all cases).
-    pub model: Model,
+    pub scenario: StudyScenario,
+    /// The distinct models of the scenario (one for a single vehicle; a
+    /// train's distinct model files), the same for all cases: a model's
+    /// macros only set parameters.
+    pub models: Vec<Model>,
+    /// For a train, the index in `models` of each vehicle's model.
+    pub vehicle_models: Vec<usize>,
     /// The engine of the cases.
     pub engine: EngineKind,
     /// End time of every case unless it sets `@end_time`, s.
@@ -197,8 +250,37 @@ impl Study {
             .from_str(text)
             .map_err(|e| ron_error(&loc, path, e))?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        let scenario = railmbs_models::load_scenario(&dir.join(&raw.scenario))?;
-        let model = railmbs_models::load_model(&scenario.model)?;
+        let (scenario, models, vehicle_models) =
+            match railmbs_models::load_any_scenario(&dir.join(&raw.scenario))? {
+                AnyScenario::Single(s) => {
+                    let model = railmbs_models::load_model(&s.model)?;
+                    (StudyScenario::Single(s), vec![model], Vec::new())
+                }
+                AnyScenario::Train(t) => {
+                    let mut files: Vec<PathBuf> = Vec::new();
+                    let mut models = Vec::new();
+                    let mut which = Vec::new();
+                    for v in &t.vehicles {
+                        let k = match files.iter().position(|f| f == &v.model) {
+                            Some(k) => k,
+                            None => {
+                                models.push(railmbs_models::load_model(&v.model)?);
+                                files.push(v.model.clone());
+                                files.len() - 1
+                            }
+                        };
+                        which.push(k);
+                    }
+                    let refs: Vec<&Model> = which.iter().map(|&k| &models[k]).collect();
+                    t.check_names(&refs)?;
+                    (StudyScenario::Train(t), models, which)
+                }
+            };
+        let model_names = models
+            .iter()
+            .map(|m| format!("\"{}\"", m.name))
+            .collect::<Vec<_>>()
+            .join(", ");
         let mut p = Problems {
             file: path,
             loc,
@@ -217,12 +299,12 @@ impl Study {
             .map(|(k, v)| (k.clone(), value_text(v)))
             .collect();
         for (name, _) in &set {
-            if model.parameters.iter().all(|q| &q.name != name) {
+            if !models.iter().any(|m| m.parameter_index(name).is_some()) {
                 p.at(
                     Some(name),
                     "set",
                     &format!("set \"{name}\""),
-                    format!("no parameter of model \"{}\" is named so", model.name),
+                    format!("no parameter of model {model_names} is named so"),
                 );
             }
         }
@@ -249,13 +331,14 @@ impl Study {
                 (CaseSource::LatinHypercube { samples, seed }, vars, rows)
             }
         };
-        cases::check_variables(&variables, &set, &model, &scenario, &mut p);
+        cases::check_variables(&variables, &set, &models, &scenario, &mut p);
         let reductions = reductions(raw.reductions, &mut p);
         let mut study = Study {
             source: path.to_path_buf(),
             scenario_text: raw.scenario,
             scenario,
-            model,
+            models,
+            vehicle_models,
             engine: raw.engine,
             end_time: raw.end_time,
             set,
@@ -274,6 +357,13 @@ impl Study {
             return Err(ModelErrors(p.errors));
         }
         Ok(study)
+    }
+
+    /// Whether a model of the study has parameter `name`.
+    pub fn has_parameter(&self, name: &str) -> bool {
+        self.models
+            .iter()
+            .any(|m| m.parameter_index(name).is_some())
     }
 
     /// The cases, in order.
@@ -315,7 +405,7 @@ impl Study {
     /// # Errors
     /// An end time or speed the scenario refuses (checked at load for every
     /// case, so only for a case built by hand).
-    pub fn case_scenario(&self, case: &Case) -> Result<Scenario, String> {
+    pub fn case_scenario(&self, case: &Case) -> Result<StudyScenario, String> {
         case.overrides.apply(&self.scenario)
     }
 }

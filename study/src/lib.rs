@@ -12,8 +12,9 @@
 //! - [`Study::load`] reads a study file (located errors, like model files);
 //!   [`Study::cases`] lists its cases, each with a stable [`Case::id`];
 //! - [`StudyEngine::prepare`] builds (through the plugin cache) and loads the
-//!   model's plugin once; [`StudyEngine::from_plugin`] loads a plugin built
-//!   elsewhere (shipped to a worker);
+//!   model's plugin once (a train: one per distinct model file);
+//!   [`StudyEngine::from_plugins`] loads plugins built elsewhere (shipped to
+//!   a worker);
 //! - [`StudyEngine::run_case`] runs one case to a [`CaseResult`] (a failed
 //!   run is a result with its error, not an error);
 //! - [`ResultStore`] is the append-only result table (one CSV row per case,
@@ -28,7 +29,7 @@
 //! // Vehicle 1 on track case 1: primary longitudinal stiffness (which sets
 //! // the primary yaw stiffness) of both bogies × running speed.
 //! Study(
-//!     // The scenario every case starts from, relative to this file.
+//!     // The scenario (or train) every case starts from, relative to this file.
 //!     scenario: "../scenarios/vehicle1_tc1.ron",
 //!     // Symbolic (default: one compiled plugin for all cases) or Numeric.
 //!     engine: Symbolic,
@@ -62,6 +63,10 @@
 //! - `@end_time`: the end time, s (replaces the study's `end_time`);
 //! - `@macro`: the name of a model macro applied after the scenario's own
 //!   (`""` for none).
+//!
+//! In a train file (`Train(...)`), parameters are train-wide (every vehicle
+//! whose model has them, as `umsim run --set` on a train) and `@macro` is
+//! not available (each vehicle has its own macros).
 //!
 //! Any other name is a free variable: it must be used in `set`, where
 //! `"{name}"` stands for its value. A model's macros are named sets of
@@ -158,7 +163,7 @@ mod store;
 
 pub use cases::{Case, Overrides};
 pub use engine::{CaseOptions, CaseResult, CaseStatus, PluginBuilds, StudyEngine};
-pub use format::{CaseSource, EngineKind, Study};
+pub use format::{CaseSource, EngineKind, Study, StudyScenario};
 pub use pool::{PoolOptions, PoolSummary, run_local, threads};
 pub use reduce::{Cell, Reduction, ReductionKind, Stat, Window, reduce_table};
 pub use store::{ResultStore, case_file, collect_case_files, read_case_file, write_case_file};

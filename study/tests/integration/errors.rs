@@ -64,6 +64,14 @@ fn bad_study_files_get_located_errors() {
             ":3:17",
             "track at constant speed",
         ),
+        (
+            format!(
+                "Study(\n  scenario: \"{}\",\n  cases: Grid({{ \"@macro\": [\"x\"] }}),\n)",
+                scenario("train3_straight.ron")
+            ),
+            ":3:17",
+            "@macro needs a single-vehicle scenario",
+        ),
     ];
     for (text, position, words) in &cases {
         let (e, path) = error(text);

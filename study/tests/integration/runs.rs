@@ -295,7 +295,7 @@ fn a_symbolic_study_builds_its_plugin_once_for_all_cases() {
     // A second engine (a worker) finds it in the cache: nothing compiled.
     let worker = StudyEngine::prepare(&study, Some(cache.clone())).unwrap();
     assert_eq!(worker.builds().compiled, 0);
-    let shipped = StudyEngine::from_plugin(&study, engine.plugin_path().unwrap()).unwrap();
+    let shipped = StudyEngine::from_plugins(&study, &engine.plugin_paths()).unwrap();
     assert_eq!(shipped.builds().derived, 0);
     let case = &study.cases()[3];
     let a = engine
@@ -305,4 +305,53 @@ fn a_symbolic_study_builds_its_plugin_once_for_all_cases() {
         .run_case(&study, case, &CaseOptions::default())
         .unwrap();
     assert_eq!(a.values, b.values);
+}
+
+#[test]
+fn a_train_study_builds_one_plugin_for_its_identical_vehicles_and_matches_a_train_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = scenario("train3_straight.ron");
+    let study = load(
+        dir.path(),
+        &format!(
+            r#"Study(scenario: "{path}", end_time: Some(0.2),
+                     cases: Grid({{ "mu": [0.3, 0.35] }}),
+                     reductions: [Max(column: "Coach3.Bogie1.WS1.contact.L.Y [N]"), Assessment])"#
+        ),
+    );
+    assert_eq!(
+        (study.models.len(), study.vehicle_models.as_slice()),
+        (1, &[0, 0, 0][..])
+    );
+    let engine = StudyEngine::prepare(&study, Some(plugin_cache_dir())).unwrap();
+    assert_eq!(engine.builds().derived, 1, "one model file, one plugin");
+    let result = engine
+        .run_case(&study, &study.cases()[1], &CaseOptions::default())
+        .unwrap();
+    assert_eq!(result.status, CaseStatus::Ok, "{:?}", result.error);
+    let record = result.record();
+
+    // The same case as `umsim run train3_straight.ron --set mu=0.35 --end-time 0.2`.
+    let mut train = railmbs_models::load_train(Path::new(&path)).unwrap();
+    train.set_parameter("mu", "0.35");
+    train.set_end_time(0.2).unwrap();
+    let model = railmbs_models::load_model(&train.vehicles[0].model).unwrap();
+    let engines: Vec<Box<dyn railmbs_runtime::Equations>> = (0..3)
+        .map(|_| {
+            Box::new(railmbs_testkit::symbolic_engine(&model))
+                as Box<dyn railmbs_runtime::Equations>
+        })
+        .collect();
+    let mut table = railmbs_runtime::run::Table::new();
+    let summary =
+        railmbs_runtime::train::run_train_into(&train, &[&model; 3], engines, &mut table, |_| {})
+            .unwrap();
+    assert!(summary.error.is_none());
+    let y = table.column("Coach3.Bogie1.WS1.contact.L.Y [N]").unwrap();
+    let max = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(
+        number(&study, &record, "max(Coach3.Bogie1.WS1.contact.L.Y [N])"),
+        max
+    );
+    assert_eq!(number(&study, &record, "assessment.wheelsets"), 12.0);
 }
