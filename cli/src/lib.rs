@@ -1,6 +1,6 @@
 //! # railmbs-cli
 //!
-//! The command-line tools: `umsim` (run, bench, conicity, creep) and `umgen`.
+//! The command-line tools: `umsim` (run, study, bench, conicity, creep) and `umgen`.
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
@@ -11,4 +11,5 @@ pub mod engine;
 pub mod info;
 pub mod plot;
 pub mod run;
+pub mod study;
 pub mod umgen;

@@ -98,7 +98,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 
 /// A flag set by Ctrl-C (SIGINT): the run stops at its next output row and
 /// keeps what it wrote. A second Ctrl-C ends the process at once.
-fn interrupt_flag() -> Arc<AtomicBool> {
+pub(crate) fn interrupt_flag() -> Arc<AtomicBool> {
     // One handler per process (the system allows only one), installed by
     // the first run; later runs share its flag.
     static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();

@@ -341,6 +341,16 @@ pub mod scenario;
 mod visit;
 
 pub use error::{ModelError, ModelErrors};
+
+/// Building blocks of the model files' RON syntax for other file formats
+/// (study descriptions): a number-or-expression value, a map in file order,
+/// the source locator that gives errors found after parsing a line and
+/// column, and RON's parse errors as located errors.
+pub mod syntax {
+    pub use crate::load::ron_error;
+    pub use crate::locate::{Locator, Span};
+    pub use crate::raw::{OrderedMap, Value};
+}
 pub use expr::{Expr, Func, VAR_NAMES};
 pub use load::{load_model, parse_model};
 pub use model::*;

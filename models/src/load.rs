@@ -72,7 +72,9 @@ fn parse_with(text: &str, file: &Path, inc: &mut Includes) -> Result<Loaded, Mod
 }
 
 /// A RON syntax or structure error, with its position and the element around it.
-pub(crate) fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError) -> ModelErrors {
+/// The RON parse error `e` of `file` as a located error: line, column and
+/// the innermost named element around it.
+pub fn ron_error(loc: &Locator, file: &Path, e: ron::error::SpannedError) -> ModelErrors {
     let pos = (e.span.start.line, e.span.start.col);
     let element = loc
         .enclosing_named(loc.offset_of(pos.0, pos.1))

@@ -10,8 +10,10 @@ enum Tok {
     Other,
 }
 
+/// The tokens of a RON text with their byte offsets and the matching
+/// brackets of every group: positions of keys, strings and elements.
 #[derive(Debug)]
-pub(crate) struct Locator<'a> {
+pub struct Locator<'a> {
     src: &'a str,
     toks: Vec<(Tok, usize)>,
     /// For an opening bracket token, the index of its closing token.
@@ -19,10 +21,11 @@ pub(crate) struct Locator<'a> {
 }
 
 /// A token range `[open, close]` of a bracketed group.
-pub(crate) type Span = (usize, usize);
+pub type Span = (usize, usize);
 
 impl<'a> Locator<'a> {
-    pub(crate) fn new(src: &'a str) -> Self {
+    /// Tokenizes `src`.
+    pub fn new(src: &'a str) -> Self {
         let bytes = src.as_bytes();
         let mut toks = Vec::new();
         let mut i = 0;
@@ -87,7 +90,7 @@ impl<'a> Locator<'a> {
     }
 
     /// 1-based (line, column in characters) of a byte offset.
-    pub(crate) fn line_col(&self, offset: usize) -> (usize, usize) {
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
         let offset = offset.min(self.src.len());
         let before = &self.src[..offset];
         let line = before.matches('\n').count() + 1;
@@ -96,7 +99,7 @@ impl<'a> Locator<'a> {
     }
 
     /// Byte offset of a 1-based (line, column) position.
-    pub(crate) fn offset_of(&self, line: usize, col: usize) -> usize {
+    pub fn offset_of(&self, line: usize, col: usize) -> usize {
         let mut off = 0;
         for (k, l) in self.src.split_inclusive('\n').enumerate() {
             if k + 1 == line {
@@ -116,7 +119,7 @@ impl<'a> Locator<'a> {
     }
 
     /// Tokens directly inside a group (depth 1), as indices.
-    fn children(&self, span: Span) -> Vec<usize> {
+    pub fn children(&self, span: Span) -> Vec<usize> {
         let mut out = Vec::new();
         let mut k = span.0 + 1;
         while k < span.1 {
@@ -130,7 +133,7 @@ impl<'a> Locator<'a> {
     }
 
     /// The group following the key `key:` directly inside `span`.
-    pub(crate) fn field_group(&self, span: Span, key: &str) -> Option<Span> {
+    pub fn field_group(&self, span: Span, key: &str) -> Option<Span> {
         let kids = self.children(span);
         let k = kids.iter().copied().find(|&k| self.is_key(k, key))?;
         let mut v = k + 2;
@@ -142,7 +145,7 @@ impl<'a> Locator<'a> {
     }
 
     /// The whole file as a span: the top-level group (after an optional `Model`).
-    pub(crate) fn top(&self) -> Option<Span> {
+    pub fn top(&self) -> Option<Span> {
         let k = self
             .toks
             .iter()
@@ -151,7 +154,7 @@ impl<'a> Locator<'a> {
     }
 
     /// The `nth` element `Ctor(… name: "name" …)` with `Ctor` one of `ctors`.
-    pub(crate) fn element(&self, ctors: &[&str], name: &str, nth: usize) -> Option<Span> {
+    pub fn element(&self, ctors: &[&str], name: &str, nth: usize) -> Option<Span> {
         (0..self.toks.len().saturating_sub(1))
             .filter_map(|k| {
                 let Tok::Ident(c) = &self.toks[k].0 else {
@@ -171,7 +174,7 @@ impl<'a> Locator<'a> {
     }
 
     /// The `nth` key string `"name":` directly inside the map group `span`.
-    pub(crate) fn map_entry(&self, span: Span, name: &str, nth: usize) -> Option<usize> {
+    pub fn map_entry(&self, span: Span, name: &str, nth: usize) -> Option<usize> {
         self.children(span)
             .into_iter()
             .filter(|&k| {
@@ -182,23 +185,23 @@ impl<'a> Locator<'a> {
     }
 
     /// The group opening at token `k`.
-    pub(crate) fn group_after(&self, k: usize) -> Option<Span> {
+    pub fn group_after(&self, k: usize) -> Option<Span> {
         Some((k, self.close.get(k).copied().flatten()?))
     }
 
     /// The first `key:` anywhere inside `span`.
-    pub(crate) fn key_anywhere(&self, span: Span, key: &str) -> Option<usize> {
+    pub fn key_anywhere(&self, span: Span, key: &str) -> Option<usize> {
         (span.0..span.1.min(self.toks.len())).find(|&k| self.is_key(k, key))
     }
 
     /// The first string literal with exactly this content inside `span`.
-    pub(crate) fn string_in(&self, span: Span, text: &str) -> Option<usize> {
+    pub fn string_in(&self, span: Span, text: &str) -> Option<usize> {
         (span.0..span.1.min(self.toks.len()))
             .find(|&k| matches!(&self.toks[k].0, Tok::Str(s) if s == text))
     }
 
     /// The constructor token before a group (the element's start), or the group itself.
-    pub(crate) fn start_of(&self, span: Span) -> usize {
+    pub fn start_of(&self, span: Span) -> usize {
         if span.0 > 0 && matches!(self.toks[span.0 - 1].0, Tok::Ident(_)) {
             span.0 - 1
         } else {
@@ -207,13 +210,13 @@ impl<'a> Locator<'a> {
     }
 
     /// Line and column of a token.
-    pub(crate) fn pos(&self, tok: usize) -> (usize, usize) {
+    pub fn pos(&self, tok: usize) -> (usize, usize) {
         self.line_col(self.toks.get(tok).map_or(self.src.len(), |t| t.1))
     }
 
     /// The innermost element (a constructor group with a `name: "…"`) containing
     /// the byte offset: its constructor and name.
-    pub(crate) fn enclosing_named(&self, offset: usize) -> Option<(String, String)> {
+    pub fn enclosing_named(&self, offset: usize) -> Option<(String, String)> {
         let mut best: Option<(usize, String, String)> = None;
         for k in 1..self.toks.len() {
             let (Tok::Punct('('), start) = &self.toks[k] else {

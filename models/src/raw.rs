@@ -9,8 +9,10 @@ use std::fmt;
 
 /// A numeric field: a number or expression text.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Value {
+pub enum Value {
+    /// A number.
     Num(f64),
+    /// Expression text.
     Text(String),
 }
 
@@ -71,7 +73,7 @@ impl<'de> Deserialize<'de> for Value {
 
 /// A map kept in file order, duplicates included (reported by the resolver).
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct OrderedMap<T>(pub Vec<(String, T)>);
+pub struct OrderedMap<T>(pub Vec<(String, T)>);
 
 impl<T> Default for OrderedMap<T> {
     fn default() -> Self {

@@ -550,19 +550,17 @@ pub fn build_train(
     let (mut q0, mut v0, mut breakpoints) = (Vec::new(), Vec::new(), Vec::new());
     let mut arc = None;
     // Contact tables built for one vehicle serve the others.
-    let mut tables = Default::default();
+    let tables = crate::forces::ContactTableCache::new();
     for (k, (model, engine)) in models.iter().zip(engines).enumerate() {
         let name = &train.vehicles[k].name;
         let scenario = train.vehicle_scenario(k, model);
         let state = scenario_state(&scenario, model)?;
         let (equations, times, binding) =
-            drive_track_frames(&scenario, model, &state.params, engine)?;
+            drive_track_frames(&scenario, model, &state.params, engine, &tables)?;
         let mut system = ModelSystem::new(model, equations, state.params)?;
         match binding {
-            Some(mut b) => {
-                b.tables = std::mem::take(&mut tables);
+            Some(b) => {
                 system.bind_track(&b)?;
-                tables = std::mem::take(&mut b.tables);
                 if arc.is_none() {
                     arc = Some((b.speed.clone(), train.vehicles[k].offset));
                 }

@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, info, plot, run};
+use railmbs_cli::{bench, conicity, creep, info, plot, run, study};
 
 #[derive(Parser)]
 #[command(
@@ -18,6 +18,8 @@ struct Cli {
 enum Command {
     /// Simulate a scenario and write its outputs as CSV.
     Run(run::Args),
+    /// Run a parameter study (cases on a local pool, resumable result table).
+    Study(study::Args),
     /// Speed of the numeric and symbolic engines on a model.
     Bench(bench::Args),
     /// Equivalent conicity of a wheelset on a track by EN 15302 (Annex B).
@@ -34,6 +36,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run(a) => run::run(a),
+        Command::Study(a) => study::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Conicity(a) => conicity::run(a),
         Command::Creep(a) => creep::run(a),

@@ -8,4 +8,5 @@ mod creep_cli;
 mod info_cli;
 mod plot_cli;
 mod run_cli;
+mod study_cli;
 mod table_cache_cli;

@@ -22,6 +22,7 @@ pub use scenario::{InitialState, scenario_state};
 pub use sink::{CsvFile, Discard, Interruptible, OutputSink, Table};
 
 use crate::Equations;
+use crate::forces::ContactTableCache;
 use crate::integrate::{self, IntegrationStats, Park, ParkSettings, Rk4, Rk4Settings, Stepper};
 use crate::model_system::ModelSystem;
 use crate::system::{MechanicalSystem, SimError};
@@ -504,6 +505,7 @@ fn prepare(
     scenario: &Scenario,
     model: &Model,
     equations: Box<dyn Equations>,
+    tables: &ContactTableCache,
 ) -> Result<ScenarioRun, RunError> {
     let InitialState {
         params,
@@ -511,7 +513,7 @@ fn prepare(
         v: v0,
     } = scenario_state(scenario, model)?;
     let (equations, breakpoints, binding) =
-        scenario::drive_track_frames(scenario, model, &params, equations)?;
+        scenario::drive_track_frames(scenario, model, &params, equations, tables)?;
     let mut system = ModelSystem::new(model, equations, params)?;
     scenario::check_integrator(&system, &scenario.integrator).map_err(|message| {
         RunError::Setup {
@@ -586,7 +588,23 @@ pub fn run_scenario_into(
     model: &Model,
     equations: Box<dyn Equations>,
     sink: &mut dyn OutputSink,
+    progress: impl FnMut(f64),
+) -> Result<RunSummary, RunError> {
+    let tables = ContactTableCache::new();
+    run_scenario_with(scenario, model, equations, sink, progress, &tables)
+}
+
+/// [`run_scenario_into`] taking the wheel–rail contact tables from
+/// `tables` and leaving the ones it builds there: the runs of a study on
+/// one model and track build each table once (a table is the same whoever
+/// builds it, so the results are too).
+pub fn run_scenario_with(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    sink: &mut dyn OutputSink,
     mut progress: impl FnMut(f64),
+    tables: &ContactTableCache,
 ) -> Result<RunSummary, RunError> {
     let engine = equations.engine_name().to_string();
     let ScenarioRun {
@@ -595,7 +613,7 @@ pub fn run_scenario_into(
         v0,
         breakpoints,
         columns,
-    } = prepare(scenario, model, equations)?;
+    } = prepare(scenario, model, equations, tables)?;
     let runner = Runner {
         integrator: &scenario.integrator,
         breakpoints: &breakpoints,

@@ -5,7 +5,7 @@
 use super::RunError;
 use crate::Equations;
 use crate::equations::Parts;
-use crate::forces::TrackBinding;
+use crate::forces::{ContactTableCache, TrackBinding};
 use crate::inputs::{DrivenEquations, InputProvider};
 use crate::model_system::ModelSystem;
 use crate::system::SimError;
@@ -54,11 +54,13 @@ pub(crate) type DrivenModel = (Box<dyn Equations>, Vec<f64>, Option<TrackBinding
 
 /// Wraps the engine of a model with track-following frames so that the
 /// scenario's track drives them; other models pass through.
+/// Contact tables come from (and go to) `tables`.
 pub(crate) fn drive_track_frames(
     scenario: &Scenario,
     model: &Model,
     params: &[f64],
     equations: Box<dyn Equations>,
+    tables: &ContactTableCache,
 ) -> Result<DrivenModel, RunError> {
     if model.track_frames.is_empty() {
         return Ok((equations, Vec::new(), None));
@@ -100,7 +102,7 @@ pub(crate) fn drive_track_frames(
         track,
         speed,
         body_offsets,
-        tables: Default::default(),
+        tables: tables.clone(),
     };
     Ok((
         Box::new(DrivenEquations::new(equations, Box::new(inputs))?),

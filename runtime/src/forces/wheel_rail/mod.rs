@@ -82,7 +82,7 @@ mod table_cache;
 
 pub use assessment::{nadal_limit, prudhomme_limit};
 pub use kinematics::MIN_ROLLING_SPEED;
-pub use preparation::{PreparedContact, TrackBinding};
+pub use preparation::{ContactTableCache, PreparedContact, TrackBinding};
 
 use super::{ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment};
 use crate::equations::BodyKinematics;

@@ -29,9 +29,37 @@ pub struct TrackBinding {
     /// Arc offset of each body's track-following frame (its own, or its
     /// nearest ancestor's), m; `None` for bodies not on a track frame.
     pub body_offsets: Vec<Option<f64>>,
-    /// Contact tables already built in this run, shared between wheelsets
-    /// with the same profiles and dimensions.
-    pub(crate) tables: Mutex<HashMap<TableKey, Arc<PreparedContact>>>,
+    /// Contact tables already built, shared between wheelsets with the
+    /// same profiles and dimensions (of this run, or of every run given the
+    /// same cache).
+    pub tables: ContactTableCache,
+}
+
+/// Contact tables in memory by the content hash of what they are built from
+/// (the profiles' points, wheel radius, flange back distance, taping-line
+/// offset, the track's gauge and rail inclination, the table's grid; see
+/// `table_cache`, which also keeps them on disk): the wheelsets of one run
+/// share them, and so do the runs given the same cache
+/// ([`run_scenario_with`](crate::run::run_scenario_with): the cases of a
+/// study, whose model and track are the same). A clone shares the tables.
+#[derive(Debug, Clone, Default)]
+pub struct ContactTableCache(Arc<Mutex<HashMap<TableKey, Arc<PreparedContact>>>>);
+
+impl ContactTableCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of tables built into it.
+    pub fn len(&self) -> usize {
+        self.0.lock().map_or(0, |t| t.len())
+    }
+
+    /// Whether no table was built into it.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// Profiles on the track: the contact table and what is derived from it.
@@ -145,6 +173,7 @@ impl WheelRailContact {
         let key = inputs.key();
         let mut tables = binding
             .tables
+            .0
             .lock()
             .map_err(|_| self.err("contact table cache poisoned"))?;
         if let Some(p) = tables.get(&key) {
