@@ -251,13 +251,14 @@ fn run_all(
     }
     if !args.quiet {
         println!(
-            "{} cases run ({} failed), {} skipped as finished, in {:.1} s on {} thread(s); plugin: {} derived, {} compiled",
+            "{} cases run ({} failed), {} skipped as finished, in {:.1} s on {} thread(s); plugin: {} derived, {} found by the index, {} compiled",
             summary.recorded,
             summary.failed,
             summary.skipped,
             start.elapsed().as_secs_f64(),
             railmbs_study::threads(args.jobs).min(pending.max(1)),
             engine.builds().derived,
+            engine.builds().indexed,
             engine.builds().compiled
         );
         println!("results                {} ({done} rows)", results.display());

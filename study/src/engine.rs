@@ -16,9 +16,13 @@ use std::time::Instant;
 /// How often a study engine derived and compiled the model's plugin.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct PluginBuilds {
-    /// Derivations of the symbolic equations (calls of the plugin build:
-    /// 1 for a symbolic study, 0 for a numeric one or a plugin given).
+    /// Derivations of the symbolic equations (1 per model of a symbolic
+    /// study whose plugin the plugin index did not know; 0 for a numeric
+    /// study or a plugin given).
     pub derived: usize,
+    /// Plugins found through the plugin index, without deriving
+    /// (`railmbs_codegen::find_or_build_plugin`).
+    pub indexed: usize,
     /// Compilations by rustc (the plugin was not in the cache).
     pub compiled: usize,
     /// Libraries loaded (the cases share the loaded library).
@@ -145,9 +149,10 @@ impl StudyEngine {
         if study.engine == EngineKind::Symbolic {
             for model in &study.models {
                 let opts = railmbs_codegen::GenerateOptions::new();
-                let built = railmbs_codegen::build_plugin(model, &opts, cache_dir.clone())
+                let built = railmbs_codegen::find_or_build_plugin(model, &opts, cache_dir.clone())
                     .map_err(|e| plugin_error(model, e))?;
-                builds.derived += 1;
+                builds.derived += usize::from(!built.indexed);
+                builds.indexed += usize::from(built.indexed);
                 builds.compiled += usize::from(!built.cache_hit);
                 let plugin =
                     Plugin::load_for(&built.path, model).map_err(|e| plugin_error(model, e))?;

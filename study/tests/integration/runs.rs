@@ -275,7 +275,7 @@ fn a_symbolic_study_builds_its_plugin_once_for_all_cases() {
     let s = run_local(&study, &engine, &mut store, &PoolOptions::default(), |_| {}).unwrap();
     assert_eq!((s.recorded, s.failed), (4, 0));
     let b = engine.builds();
-    assert_eq!((b.derived, b.compiled, b.loaded), (1, 1, 1));
+    assert_eq!((b.derived, b.indexed, b.compiled, b.loaded), (1, 0, 1, 1));
     // One library in the fresh cache.
     fn libraries(dir: &Path) -> usize {
         std::fs::read_dir(dir)
@@ -292,9 +292,11 @@ fn a_symbolic_study_builds_its_plugin_once_for_all_cases() {
             .sum()
     }
     assert_eq!(libraries(&cache), 1);
-    // A second engine (a worker) finds it in the cache: nothing compiled.
+    // A second engine (a worker) finds it through the plugin index: nothing
+    // derived, nothing compiled.
     let worker = StudyEngine::prepare(&study, Some(cache.clone())).unwrap();
-    assert_eq!(worker.builds().compiled, 0);
+    let w = worker.builds();
+    assert_eq!((w.derived, w.indexed, w.compiled, w.loaded), (0, 1, 0, 1));
     let shipped = StudyEngine::from_plugins(&study, &engine.plugin_paths()).unwrap();
     assert_eq!(shipped.builds().derived, 0);
     let case = &study.cases()[3];
@@ -324,7 +326,8 @@ fn a_train_study_builds_one_plugin_for_its_identical_vehicles_and_matches_a_trai
         (1, &[0, 0, 0][..])
     );
     let engine = StudyEngine::prepare(&study, Some(plugin_cache_dir())).unwrap();
-    assert_eq!(engine.builds().derived, 1, "one model file, one plugin");
+    let b = engine.builds();
+    assert_eq!(b.derived + b.indexed, 1, "one model file, one plugin");
     let result = engine
         .run_case(&study, &study.cases()[1], &CaseOptions::default())
         .unwrap();
