@@ -49,12 +49,27 @@ def test_an_exception_in_the_callback_stops_the_run_and_is_reraised():
 
 
 def test_ctrl_c_stops_the_run_with_keyboard_interrupt():
+    """SIGINT while the run is in Rust (GIL released): the next progress
+    tick runs Python's handler and the run stops with KeyboardInterrupt.
+    The signal is sent from another thread once the run is under way (its
+    first progress call), so it cannot hit the test before the run."""
     if threading.current_thread() is not threading.main_thread():
         pytest.skip("signals reach the main thread only")
-    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
-    timer.start()
+    timers, seen = [], []
+
+    def progress(t, t_end):
+        seen.append(t)
+        if not timers:
+            timers.append(threading.Timer(0.05, lambda: os.kill(os.getpid(), signal.SIGINT)))
+            timers[0].start()
+
     try:
         with pytest.raises(KeyboardInterrupt):
-            long_run().run()
+            long_run().run(progress=progress)
     finally:
-        timer.cancel()
+        for timer in timers:
+            timer.cancel()
+    assert timers, "the run never called progress"
+    # Stopped early: a KeyboardInterrupt raised only after the run had
+    # finished (its last progress call is at t_end) would not count.
+    assert max(seen) < 1e4
