@@ -4,6 +4,7 @@ Units are SI throughout; see the docstrings (``help(railmbs.Scenario)``).
 """
 
 from os import PathLike
+from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
@@ -31,8 +32,8 @@ class Model:
     @property
     def name(self) -> str: ...
     @property
-    def path(self) -> Optional[str]:
-        """The file it was read from."""
+    def path(self) -> Optional[Path]:
+        """The file it was read from (the path given with a string)."""
     @property
     def parameters(self) -> Dict[str, float]:
         """Parameter long names and default values (SI units)."""
@@ -59,7 +60,8 @@ class Scenario:
         resolves its model, track and output files relative to its folder;
         ``model`` is run instead of the model file the text names."""
     @property
-    def path(self) -> str: ...
+    def path(self) -> Path:
+        """The scenario file (or the path given with its text)."""
     @property
     def is_train(self) -> bool: ...
     @property
