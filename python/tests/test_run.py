@@ -144,3 +144,22 @@ def test_a_failed_simulation_raises_with_the_rows_before():
     assert e.result is not None and 0 < len(e.result) and e.result["time"][-1] <= e.time
     assert np.all(np.isfinite(e.result["z"]))
     assert "python_unstable.ron" in str(e)
+
+
+def test_macros_apply_as_their_assignments():
+    """The double pendulum's macro `equal_rods` ({l2: l1, m2: m1}) gives the
+    run of the same assignments made with `set`; an unknown macro is a
+    located ModelError."""
+    sc = railmbs.Scenario.load(SCENARIOS / "double_pendulum.ron")
+    sc.end_time = 0.3
+    by_hand = sc.copy()
+    by_hand.set("l2", "l1")
+    by_hand.set("m2", "m1")
+    sc.macros = ["equal_rods"]
+    assert sc.macros == ["equal_rods"]
+    a, b = sc.run(), by_hand.run()
+    assert np.array_equal(a["q2"], b["q2"])
+    assert not np.array_equal(a["q2"], railmbs.run(SCENARIOS / "double_pendulum.ron", end_time=0.3)["q2"])
+    sc.macros = ["no_such_macro"]
+    with pytest.raises(railmbs.ModelError, match="no_such_macro"):
+        sc.run()
