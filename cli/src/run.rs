@@ -148,9 +148,78 @@ fn progress_bar(args: &Args) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
-/// `umsim run` of a train file: one engine per vehicle; the symbolic engine
-/// builds (or loads) one plugin per distinct model file, shared by identical
-/// vehicles. `--plugin` serves trains whose vehicles all use one model.
+/// A train's models and engines: each distinct model file loaded once
+/// (with `creep` as the law of its wheel–rail elements, if given) and, for
+/// the symbolic engine, its plugin built (or found in the cache) once and
+/// shared by identical vehicles; `plugin` serves trains whose vehicles all
+/// use one model.
+pub struct TrainEngines {
+    /// The distinct models, in order of first use.
+    pub models: Vec<railmbs_models::Model>,
+    /// Index into `models` of each vehicle's model, in vehicle order.
+    pub vehicle_models: Vec<usize>,
+    /// One engine per vehicle, in vehicle order.
+    pub engines: Vec<Box<dyn railmbs_runtime::Equations>>,
+}
+
+impl TrainEngines {
+    /// Loads the models of `train` and builds one `engine` per vehicle.
+    ///
+    /// # Errors
+    /// A model file's problems, a plugin that cannot be built or loaded,
+    /// `plugin` given for a train of several model files.
+    pub fn build(
+        train: &railmbs_models::TrainScenario,
+        engine: Engine,
+        plugin: Option<&std::path::Path>,
+        creep: Option<&railmbs_models::CreepLawSpec<railmbs_models::Expr>>,
+    ) -> Result<Self, Box<dyn std::error::Error>> {
+        // Distinct model files, loaded (and compiled) once each.
+        let mut files: Vec<(PathBuf, railmbs_models::Model, Option<PathBuf>)> = Vec::new();
+        let mut which = Vec::new();
+        for v in &train.vehicles {
+            let k = match files.iter().position(|(p, _, _)| p == &v.model) {
+                Some(k) => k,
+                None => {
+                    let mut model = railmbs_models::load_model(&v.model)?;
+                    if let Some(law) = creep {
+                        model.set_creep_law(law);
+                    }
+                    let plugin = match (engine, plugin) {
+                        (Engine::Numeric, _) => None,
+                        (Engine::Symbolic, Some(p)) => Some(p.to_path_buf()),
+                        (Engine::Symbolic, None) => {
+                            Some(crate::engine::build_symbolic(&model, false)?.path)
+                        }
+                    };
+                    files.push((v.model.clone(), model, plugin));
+                    files.len() - 1
+                }
+            };
+            which.push(k);
+        }
+        if plugin.is_some() && files.len() > 1 {
+            return Err(format!(
+                "--plugin serves one model, but the train {} uses {} model files; \
+                 leave it out to build each model's plugin",
+                train.source.display(),
+                files.len()
+            )
+            .into());
+        }
+        let engines = which
+            .iter()
+            .map(|&k| build_engine(&files[k].1, engine, files[k].2.as_deref()))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            models: files.into_iter().map(|(_, m, _)| m).collect(),
+            vehicle_models: which,
+            engines,
+        })
+    }
+}
+
+/// `umsim run` of a train file: one engine per vehicle ([`TrainEngines`]).
 fn run_train(
     args: &Args,
     train: &railmbs_models::TrainScenario,
@@ -160,41 +229,12 @@ fn run_train(
     } else {
         args.engine
     };
-    // Distinct model files, loaded (and compiled) once each.
-    let mut files: Vec<(PathBuf, railmbs_models::Model, Option<PathBuf>)> = Vec::new();
-    let mut which = Vec::new();
-    for v in &train.vehicles {
-        let k = match files.iter().position(|(p, _, _)| p == &v.model) {
-            Some(k) => k,
-            None => {
-                let model = railmbs_models::load_model(&v.model)?;
-                let plugin = match (engine, &args.plugin) {
-                    (Engine::Numeric, _) => None,
-                    (Engine::Symbolic, Some(p)) => Some(p.clone()),
-                    (Engine::Symbolic, None) => {
-                        Some(crate::engine::build_symbolic(&model, false)?.path)
-                    }
-                };
-                files.push((v.model.clone(), model, plugin));
-                files.len() - 1
-            }
-        };
-        which.push(k);
-    }
-    if args.plugin.is_some() && files.len() > 1 {
-        return Err(format!(
-            "--plugin serves one model, but the train {} uses {} model files; \
-             leave it out to build each model's plugin",
-            args.scenario.display(),
-            files.len()
-        )
-        .into());
-    }
-    let models: Vec<&railmbs_models::Model> = which.iter().map(|&k| &files[k].1).collect();
-    let engines = which
-        .iter()
-        .map(|&k| build_engine(&files[k].1, engine, files[k].2.as_deref()))
-        .collect::<Result<Vec<_>, _>>()?;
+    let TrainEngines {
+        models,
+        vehicle_models,
+        engines,
+    } = TrainEngines::build(train, engine, args.plugin.as_deref(), None)?;
+    let models: Vec<&railmbs_models::Model> = vehicle_models.iter().map(|&k| &models[k]).collect();
     let output = args.output.clone().or_else(|| train.output_file.clone());
     let bar = progress_bar(args);
     let t_end = train.end_time;

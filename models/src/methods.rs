@@ -39,6 +39,20 @@ impl Model {
         }
     }
 
+    /// Replaces the creep law of every wheel–rail element by `law` (`umsim
+    /// bench --creep`, the Python package's `Scenario.set_creep_law`);
+    /// returns the number of elements changed (0: the model has none).
+    pub fn set_creep_law(&mut self, law: &crate::model::CreepLawSpec<Expr>) -> usize {
+        let mut changed = 0;
+        for f in &mut self.forces {
+            if let crate::forces::ForceKind::WheelRail(w) = &mut f.kind {
+                w.creep = law.clone();
+                changed += 1;
+            }
+        }
+        changed
+    }
+
     /// Parameter names, index = `Expr::Param` index.
     pub fn parameter_names(&self) -> Vec<String> {
         self.parameters.iter().map(|p| p.name.clone()).collect()

@@ -61,7 +61,6 @@ pub use report::{BenchReport, EngineTimes};
 pub use timing::{BATCH_SECONDS, BATCHES, MAX_RUNS, RUN_SECONDS, time_per_call};
 pub use workload::{Dynamics, MassAndBias, State, random_states, run_scenario_once};
 
-use railmbs_models::Model;
 use std::path::PathBuf;
 
 /// Which engines to measure (the numeric engine is always measured).
@@ -110,22 +109,6 @@ pub fn parse_creep(
 ) -> Result<railmbs_models::CreepLawSpec<railmbs_models::Expr>, String> {
     let spec: railmbs_models::CreepLawSpec = text.parse().map_err(|e| format!("--creep: {e}"))?;
     Ok(spec.map(|_, &x| railmbs_models::Expr::Num(x)))
-}
-
-/// Replaces the creep law of every wheel–rail element; `false` when the
-/// model has none.
-fn override_creep(
-    model: &mut Model,
-    law: &railmbs_models::CreepLawSpec<railmbs_models::Expr>,
-) -> bool {
-    let mut found = false;
-    for f in &mut model.forces {
-        if let railmbs_models::ForceKind::WheelRail(w) = &mut f.kind {
-            w.creep = law.clone();
-            found = true;
-        }
-    }
-    found
 }
 
 /// Runs all measurements (no printing).

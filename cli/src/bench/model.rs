@@ -6,7 +6,7 @@ use super::process::whole_process;
 use super::report::{BenchReport, EngineTimes};
 use super::timing::median_run;
 use super::workload::{MakeEngine, random_states, run_scenario_once, time_engine};
-use super::{Args, BenchEngine, override_creep, parse_creep};
+use super::{Args, BenchEngine, parse_creep};
 use crate::engine::{Engine, build_engine, build_engine_with};
 use railmbs_models::{Model, Scenario};
 use std::path::{Path, PathBuf};
@@ -81,7 +81,7 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
     let mut model = railmbs_models::load_model(&args.model)?;
     if let Some(text) = &args.creep {
         let law = parse_creep(text)?;
-        if !override_creep(&mut model, &law) {
+        if model.set_creep_law(&law) == 0 {
             return Err(format!(
                 "--creep: model {} has no wheel–rail element",
                 args.model.display()

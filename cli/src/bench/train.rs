@@ -7,7 +7,7 @@ use super::process::whole_process;
 use super::report::{BenchReport, EngineTimes};
 use super::timing::{Stopwatch, median_run};
 use super::workload::{random_states, time_engine};
-use super::{Args, BenchEngine, override_creep, parse_creep};
+use super::{Args, BenchEngine, parse_creep};
 use crate::engine::{Engine, build_engine, build_engine_with};
 use railmbs_models::Model;
 use railmbs_runtime::Equations;
@@ -56,7 +56,7 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
     for v in &train.vehicles {
         let mut m = railmbs_models::load_model(&v.model)?;
         if let Some(law) = &law {
-            override_creep(&mut m, law);
+            m.set_creep_law(law);
         }
         models.push(m);
     }

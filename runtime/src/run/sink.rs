@@ -181,6 +181,12 @@ impl Table {
         &self.columns
     }
 
+    /// The columns, in header order, without copying them (for bindings
+    /// that hand them on, e.g. as numpy arrays).
+    pub fn into_columns(self) -> Vec<Vec<f64>> {
+        self.columns
+    }
+
     /// Number of rows.
     pub fn rows(&self) -> usize {
         self.columns.first().map_or(0, Vec::len)
