@@ -1,6 +1,6 @@
 //! # railmbs-cli
 //!
-//! The command-line tools: `umsim` (run, bench, conicity, creep) and `umgen`.
+//! The command-line tools: `umsim` (run, bench, conicity, creep, info, plot, equilibrium) and `umgen`.
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
@@ -8,6 +8,7 @@ pub mod bench;
 pub mod conicity;
 pub mod creep;
 pub mod engine;
+pub mod equilibrium;
 pub mod info;
 pub mod plot;
 pub mod run;

@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, info, plot, run};
+use railmbs_cli::{bench, conicity, creep, equilibrium, info, plot, run};
 
 #[derive(Parser)]
 #[command(
@@ -28,6 +28,8 @@ enum Command {
     Plot(plot::Args),
     /// A model's parameters, macros, coordinates, bodies, force elements and outputs.
     Info(info::Args),
+    /// The static (steady) equilibrium at a scenario's start: coordinates and wheel loads.
+    Equilibrium(equilibrium::Args),
 }
 
 fn main() {
@@ -39,6 +41,7 @@ fn main() {
         Command::Creep(a) => creep::run(a),
         Command::Plot(a) => plot::run(a),
         Command::Info(a) => info::run(a),
+        Command::Equilibrium(a) => equilibrium::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

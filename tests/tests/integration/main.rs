@@ -3,6 +3,7 @@
 
 mod dynamics;
 mod equations;
+mod equilibrium;
 mod plugins;
 mod symbolic;
 mod track_frames;
