@@ -10,7 +10,11 @@
 //!   **position** unknown, at rest relative to its frame (q̇ = 0);
 //! - a coordinate without stiffness that moves (q̇₀ ≠ 0) and on whose rate
 //!   some force depends (a wheelset's spin: the creep forces) is a **rate**
-//!   unknown: it keeps its position and rolls at the rate that balances it;
+//!   unknown: it keeps its position and rolls at the rate that balances it
+//!   ("without stiffness" for a moving coordinate: below 1e-6 of the
+//!   stiffest column, as an elastic rail's inner iteration leaves a few
+//!   N/rad of noise in a spin's column against contact stiffnesses of
+//!   1e8 N/m);
 //! - any other coordinate is **held** as given (position and rate: a free
 //!   longitudinal coordinate, a spin angle without creep). Its equation must
 //!   hold by itself; if it does not (a body without support falls), there is
@@ -71,9 +75,9 @@ pub struct EquilibriumSettings {
 impl Default for EquilibriumSettings {
     fn default() -> Self {
         Self {
-            max_iterations: 50,
+            max_iterations: 100,
             force_tolerance: None,
-            max_step: 0.01,
+            max_step: 0.1,
             max_rate_change: 0.1,
         }
     }
@@ -255,14 +259,25 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
     let scale = f0.amax().max(heaviest * 9.81).max(1.0);
 
     // Roles from the difference columns at the guess.
-    let mut roles = vec![Role::Held; n];
+    let mut stiffness = vec![0.0; n];
     for i in 0..n {
         let h = position_step(q[i]);
         let x = q[i];
         q[i] = x + h;
         let df = eval.force(system, &q, &v)? - &f0;
         q[i] = x;
-        if df.amax() / h > noise_level(scale, h) {
+        stiffness[i] = df.amax() / h;
+    }
+    let stiffest = stiffness.iter().fold(0.0f64, |a, &k| a.max(k));
+    let mut roles = vec![Role::Held; n];
+    for i in 0..n {
+        let h = position_step(q[i]);
+        let stiff = stiffness[i] > noise_level(scale, h);
+        // A moving coordinate whose stiffness is a millionth of the
+        // stiffest rolls (a wheel's spin: on elastic rails the inner
+        // iteration leaves a few N/rad of noise in its column).
+        let rolling = v[i] != 0.0 && stiffness[i] < 1e-6 * stiffest;
+        if stiff && !rolling {
             roles[i] = Role::Position;
         } else if v[i] != 0.0 {
             let h = rate_step(v[i]);
@@ -272,6 +287,8 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
             v[i] = x;
             if df.amax() / h > noise_level(scale, h) {
                 roles[i] = Role::Rate;
+            } else if stiff {
+                roles[i] = Role::Position;
             }
         }
     }
