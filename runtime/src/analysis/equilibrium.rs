@@ -106,6 +106,8 @@ pub struct Equilibrium {
     pub residual: f64,
     /// The tolerance it met, N or N m.
     pub tolerance: f64,
+    /// Wall-clock time of the solve, s (a benchmark figure).
+    pub seconds: f64,
 }
 
 /// Why no equilibrium was found.
@@ -239,6 +241,49 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
     v0: &[f64],
     settings: &EquilibriumSettings,
 ) -> Result<Equilibrium, EquilibriumError> {
+    let start = std::time::Instant::now();
+    let (mut q, mut v) = (q0.to_vec(), v0.to_vec());
+    let mut iterations = 0;
+    let mut previous_roles = None;
+    loop {
+        let (mut eq, unbalanced) = solve_with_roles_at(system, names, t, &q, &v, settings)?;
+        iterations += eq.iterations;
+        // Held coordinates left unbalanced may have found their forces at
+        // the new state (a wheel that reached its rail now rolls on it):
+        // decide the roles there and solve again, until they settle.
+        if unbalanced.is_empty() || previous_roles.as_ref() == Some(&eq.roles) {
+            if !unbalanced.is_empty() {
+                return Err(EquilibriumError::Unbalanced {
+                    carriers: unbalanced,
+                });
+            }
+            eq.iterations = iterations;
+            eq.q_start = q0.to_vec();
+            eq.v_start = v0.to_vec();
+            eq.seconds = start.elapsed().as_secs_f64();
+            return Ok(eq);
+        }
+        previous_roles = Some(eq.roles.clone());
+        q.clone_from(&eq.q);
+        // Held rates stay as given; positions rest.
+        for i in 0..v.len() {
+            if eq.roles[i] != Role::Held {
+                v[i] = eq.v[i];
+            }
+        }
+    }
+}
+
+/// One solve with the roles decided at (q₀, q̇₀); the held coordinates left
+/// unbalanced are returned with the state reached.
+fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
+    system: &mut S,
+    names: &[CoordinateInfo],
+    t: f64,
+    q0: &[f64],
+    v0: &[f64],
+    settings: &EquilibriumSettings,
+) -> Result<(Equilibrium, Vec<(String, f64)>), EquilibriumError> {
     let (n, nc) = (system.dof(), system.n_constraints());
     if q0.len() != n || v0.len() != n || names.len() != n {
         return Err(SimError::Other(format!(
@@ -367,7 +412,30 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
                 }
             }
         }
-        let mut dx = solve_equilibrated(&jac, &r, names, &unknowns)?;
+        let mut dx = match solve_equilibrated(&jac, &r, names, &unknowns, true) {
+            Err(Singular::Loaded) => {
+                // A direction without stiffness that a force pushes along
+                // (a wheel above its rail, gravity on it): a step of damped
+                // motion under the forces, (J − M/τ²) δx = −r, instead
+                // (pseudo-transient continuation; τ = 0.01 s moves a body
+                // by at most g τ² ≈ 1 mm).
+                let tau: f64 = 0.01;
+                let mut regularized = jac.clone();
+                for (a, &(i, _)) in unknowns.map.iter().enumerate() {
+                    for (b, &(j, role)) in unknowns.map.iter().enumerate() {
+                        let scale = if role == Role::Rate { tau } else { tau * tau };
+                        regularized[(a, b)] -= eval.mass()[(i, j)] / scale;
+                    }
+                }
+                solve_equilibrated(&regularized, &r, names, &unknowns, false)
+            }
+            other => other,
+        }
+        .map_err(|e| match e {
+            Singular::Free(direction) => EquilibriumError::Unconstrained { direction },
+            Singular::Loaded => unreachable!("only returned when asked"),
+            Singular::Sim(e) => e.into(),
+        })?;
         dx.neg_mut();
         // Cap the step: positions by max_step, rates relatively.
         let mut cap: f64 = 1.0;
@@ -408,12 +476,7 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
         .copied()
         .filter(|&i| full[i].abs() > tolerance)
         .collect();
-    if !unbalanced.is_empty() {
-        return Err(EquilibriumError::Unbalanced {
-            carriers: carriers(&full, &unbalanced, names),
-        });
-    }
-    Ok(Equilibrium {
+    let eq = Equilibrium {
         t,
         q,
         v,
@@ -424,19 +487,34 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
         iterations,
         residual: full.amax(),
         tolerance,
-    })
+        seconds: 0.0,
+    };
+    Ok((eq, carriers(&full, &unbalanced, names)))
+}
+
+/// Why [`solve_equilibrated`] found no step.
+enum Singular {
+    /// A singular direction along which the residual has no component: the
+    /// equilibrium is not unique (the direction, named).
+    Free(Vec<(String, f64)>),
+    /// A singular direction that the residual pushes along.
+    Loaded,
+    /// The SVD failed.
+    Sim(SimError),
 }
 
 /// Solves `jac dx = r` with the columns scaled to unit norm (so that metres,
 /// radians, rates and multipliers weigh alike) by SVD; a singular value
-/// below 1e-12 of the largest is an unconstrained direction, named by its
-/// right singular vector.
+/// below 1e-12 of the largest is a direction without stiffness: free
+/// (named by its right singular vector) when the residual has no component
+/// along it (below 1e-9 of |r|) or when `loaded_ok` is false, else loaded.
 fn solve_equilibrated(
     jac: &DMatrix<f64>,
     r: &DVector<f64>,
     names: &[CoordinateInfo],
     unknowns: &Unknowns,
-) -> Result<DVector<f64>, EquilibriumError> {
+    loaded_ok: bool,
+) -> Result<DVector<f64>, Singular> {
     let m = jac.ncols();
     let scales: Vec<f64> = (0..m)
         .map(|k| {
@@ -458,6 +536,11 @@ fn solve_equilibrated(
         });
     let v_t = svd.v_t.as_ref().expect("SVD computed with V");
     if kmin.0.is_nan() || kmin.0 <= 1e-12 * smax {
+        let u = svd.u.as_ref().expect("SVD computed with U");
+        let along = u.column(kmin.1).dot(r).abs();
+        if loaded_ok && along > 1e-9 * r.norm() {
+            return Err(Singular::Loaded);
+        }
         let row = v_t.row(kmin.1);
         let direction: Vec<f64> = (0..m).map(|k| row[k] * scales[k]).collect();
         let big = direction.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -475,11 +558,11 @@ fn solve_equilibrated(
             })
             .collect();
         named.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-        return Err(EquilibriumError::Unconstrained { direction: named });
+        return Err(Singular::Free(named));
     }
     let mut dx = svd
         .solve(r, 0.0)
-        .map_err(|e| SimError::Other(format!("equilibrium: {e}")))?;
+        .map_err(|e| Singular::Sim(SimError::Other(format!("equilibrium: {e}"))))?;
     for (k, s) in scales.iter().enumerate() {
         dx[k] *= s;
     }

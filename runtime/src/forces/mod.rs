@@ -24,7 +24,7 @@ pub use contact::{PointPlane, contact_stiffness_damping};
 pub use linear6::Linear6;
 pub use nonlinear::{Characteristic, CoulombFriction, LoadFriction, Tabulated};
 pub use series::SeriesSpringDamper;
-pub use wheel_rail::{TrackBinding, WheelRailContact};
+pub use wheel_rail::{ContactTables, TrackBinding, WheelRailContact};
 
 pub(crate) use attach::{
     Attachment, FrameAttachment, add_force, add_generalized_force, add_moment, eval_scalar,

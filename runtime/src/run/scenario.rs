@@ -8,7 +8,7 @@ use crate::analysis::{
     self, CoordinateInfo, equilibrium::Equilibrium, equilibrium::EquilibriumSettings,
 };
 use crate::equations::Parts;
-use crate::forces::TrackBinding;
+use crate::forces::{ContactTables, TrackBinding};
 use crate::inputs::{DrivenEquations, InputProvider};
 use crate::model_system::ModelSystem;
 use crate::system::MechanicalSystem;
@@ -144,6 +144,18 @@ pub fn scenario_system(
     model: &Model,
     equations: Box<dyn Equations>,
 ) -> Result<ScenarioSystem, RunError> {
+    scenario_system_sharing(scenario, model, equations, &mut ContactTables::default())
+}
+
+/// [`scenario_system`] with the wheel–rail contact tables of `tables`
+/// (those built here are added): the systems of a sweep over speed or
+/// parameters build each table once.
+pub fn scenario_system_sharing(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    tables: &mut ContactTables,
+) -> Result<ScenarioSystem, RunError> {
     let setup = |message: String| RunError::Setup {
         file: scenario.source.clone(),
         message,
@@ -153,13 +165,18 @@ pub fn scenario_system(
         q: q0,
         v: v0,
     } = scenario_state(scenario, model)?;
-    let (equations, breakpoints, binding) =
+    let (equations, breakpoints, mut binding) =
         drive_track_frames(scenario, model, &params, equations)?;
     let mut system = ModelSystem::new(model, equations, params)?;
     check_integrator(&system, &scenario.integrator).map_err(setup)?;
     let (mut q0, mut v0) = system.initial_state(0.0, &q0, &v0)?;
-    match &binding {
-        Some(b) => system.bind_track(b)?,
+    match &mut binding {
+        Some(b) => {
+            b.tables = std::mem::take(tables);
+            let bound = system.bind_track(b);
+            *tables = std::mem::take(&mut b.tables);
+            bound?;
+        }
         None => {
             if let Some(f) = system.forces().iter().find(|f| f.needs_track()) {
                 return Err(setup(format!(

@@ -81,7 +81,7 @@ mod solve;
 
 pub use assessment::{nadal_limit, prudhomme_limit};
 pub use kinematics::MIN_ROLLING_SPEED;
-pub use preparation::{PreparedContact, TrackBinding};
+pub use preparation::{ContactTables, PreparedContact, TrackBinding};
 
 use super::{ForceContext, ForceElement, ForceJacobian, Wrench, add_force, add_moment};
 use crate::equations::BodyKinematics;

@@ -19,6 +19,11 @@ use railmbs_wheelrail::profile::{Profile, ProfileSettings};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
+/// Contact tables built in a run (by profiles and dimensions), to share
+/// between wheelsets and, moved from one binding to the next, between the
+/// systems of a sweep (trains, speeds).
+pub type ContactTables = Mutex<HashMap<String, Arc<PreparedContact>>>;
+
 /// The scenario's track, as the wheel–rail elements see it.
 pub struct TrackBinding {
     /// The track.
@@ -30,7 +35,7 @@ pub struct TrackBinding {
     pub body_offsets: Vec<Option<f64>>,
     /// Contact tables already built in this run, shared between wheelsets
     /// with the same profiles and dimensions.
-    pub tables: Mutex<HashMap<String, Arc<PreparedContact>>>,
+    pub tables: ContactTables,
 }
 
 /// Profiles on the track: the contact table and what is derived from it.
