@@ -266,9 +266,9 @@ pub fn solve<S: MechanicalSystem + ?Sized>(
         previous_roles = Some(eq.roles.clone());
         q.clone_from(&eq.q);
         // Held rates stay as given; positions rest.
-        for i in 0..v.len() {
-            if eq.roles[i] != Role::Held {
-                v[i] = eq.v[i];
+        for ((vi, &role), &solved) in v.iter_mut().zip(&eq.roles).zip(&eq.v) {
+            if role != Role::Held {
+                *vi = solved;
             }
         }
     }
