@@ -1,6 +1,6 @@
 //! # railmbs-cli
 //!
-//! The command-line tools: `umsim` (run, bench, conicity, creep, info, plot, equilibrium) and `umgen`.
+//! The command-line tools: `umsim` (run, bench, conicity, creep, info, plot, equilibrium, modes) and `umgen`.
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
@@ -10,6 +10,7 @@ pub mod creep;
 pub mod engine;
 pub mod equilibrium;
 pub mod info;
+pub mod modes;
 pub mod plot;
 pub mod run;
 pub mod umgen;

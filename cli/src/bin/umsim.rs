@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, equilibrium, info, plot, run};
+use railmbs_cli::{bench, conicity, creep, equilibrium, info, modes, plot, run};
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +30,8 @@ enum Command {
     Info(info::Args),
     /// The static (steady) equilibrium at a scenario's start: coordinates and wheel loads.
     Equilibrium(equilibrium::Args),
+    /// Linear modes at a scenario's steady state, a root locus over speed, the linear critical speed.
+    Modes(modes::Args),
 }
 
 fn main() {
@@ -42,6 +44,7 @@ fn main() {
         Command::Plot(a) => plot::run(a),
         Command::Info(a) => info::run(a),
         Command::Equilibrium(a) => equilibrium::run(a),
+        Command::Modes(a) => modes::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

@@ -2,13 +2,23 @@
 //! see (a [`MechanicalSystem`], e.g. a [`ModelSystem`] of either engine):
 //!
 //! - [`equilibrium`]: the static (steady) equilibrium, f(q, q̇) = 0 at
-//!   q̈ = 0, by Newton's method with a line search.
+//!   q̈ = 0, by Newton's method with a line search;
+//! - [`linear`]: the Jacobian A of the first-order equations
+//!   d/dt [q; q̇] = F(q, q̇) at such a state, by central differences of the
+//!   full model;
+//! - [`modes`]: eigenvalues, frequencies, damping ratios and mode shapes
+//!   of A, named by their dominant coordinates;
+//! - [`speed`]: all three for a scenario at a speed, root loci over speed
+//!   and the linear critical speed.
 //!
 //! Every analysis evaluates the model only through
 //! [`MechanicalSystem::dynamics`] and [`MechanicalSystem::constraints`]:
 //! there is no second model evaluation to keep consistent.
 
 pub mod equilibrium;
+pub mod linear;
+pub mod modes;
+pub mod speed;
 
 use crate::model_system::ModelSystem;
 use crate::system::{MechanicalSystem, SimError};

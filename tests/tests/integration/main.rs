@@ -4,6 +4,7 @@
 mod dynamics;
 mod equations;
 mod equilibrium;
+mod modes;
 mod plugins;
 mod symbolic;
 mod track_frames;
