@@ -1,6 +1,6 @@
 //! # railmbs-cli
 //!
-//! The command-line tools: `umsim` (run, study, bench, conicity, creep) and `umgen`.
+//! The command-line tools: `umsim` (run, study, bench, conicity, creep, info, plot, equilibrium, modes) and `umgen`.
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
@@ -8,7 +8,9 @@ pub mod bench;
 pub mod conicity;
 pub mod creep;
 pub mod engine;
+pub mod equilibrium;
 pub mod info;
+pub mod modes;
 pub mod plot;
 pub mod run;
 pub mod study;

@@ -50,6 +50,22 @@ pub struct InitialOverride {
     pub velocity: Option<f64>,
 }
 
+/// Where a run starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum InitialStateKind {
+    /// At the model's `init` and `vel` with the scenario's `initial`
+    /// overrides, as given.
+    #[default]
+    Given,
+    /// At the static (steady) equilibrium found from the given state: the
+    /// coordinates with stiffness settle where the forces balance at zero
+    /// velocity relative to their frames, rolling coordinates (moving, no
+    /// stiffness: wheel spin) keep rolling at the rate that balances them,
+    /// and coordinates without stiffness or damping stay as given
+    /// (`umsim equilibrium` shows the solution).
+    Equilibrium,
+}
+
 /// Which variables go to the output file besides `time`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputSpec {
@@ -161,7 +177,11 @@ pub struct Scenario {
     pub parameters: Vec<(String, String)>,
     /// Initial-condition overrides of coordinates (`initial`), replacing the
     /// model's `init` and `vel`; checked by [`Scenario::initial_state`].
+    /// With `initial_state: Equilibrium` they are the starting guess.
     pub initial: Vec<InitialOverride>,
+    /// Whether the run starts at the given state or at the equilibrium
+    /// found from it (`initial_state: Equilibrium`).
+    pub initial_kind: InitialStateKind,
     /// Simulated time from t = 0, s.
     pub end_time: f64,
     /// The integrator and its settings.
@@ -204,6 +224,8 @@ struct RawScenario {
     parameters: OrderedMap<Value>,
     #[serde(default)]
     initial: Vec<RawInitial>,
+    #[serde(default)]
+    initial_state: InitialStateKind,
     end_time: f64,
     integrator: RawIntegrator,
     output: RawOutput,
@@ -351,6 +373,7 @@ pub fn parse_scenario(text: &str, path: &Path) -> Result<Scenario, ModelErrors> 
                 velocity: i.velocity,
             })
             .collect(),
+        initial_kind: raw.initial_state,
         end_time: raw.end_time,
         integrator,
         output,
@@ -1309,6 +1332,7 @@ impl TrainScenario {
             macros: v.macros.clone(),
             parameters,
             initial: v.initial.clone(),
+            initial_kind: InitialStateKind::Given,
             end_time: self.end_time,
             integrator: self.integrator.clone(),
             output: OutputSpec {

@@ -19,6 +19,7 @@
 //! | [`integrate::Park`], [`integrate::Rk4`] | [`Stepper`] | a solver stepping a `MechanicalSystem` |
 //! | [`run`] | | the runner: steps a solver, writes rows to an [`run::OutputSink`] |
 
+pub mod analysis;
 pub mod equations;
 pub mod forces;
 pub mod inputs;

@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, info, plot, run, study};
+use railmbs_cli::{bench, conicity, creep, equilibrium, info, modes, plot, run, study};
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +30,10 @@ enum Command {
     Plot(plot::Args),
     /// A model's parameters, macros, coordinates, bodies, force elements and outputs.
     Info(info::Args),
+    /// The static (steady) equilibrium at a scenario's start: coordinates and wheel loads.
+    Equilibrium(equilibrium::Args),
+    /// Linear modes at a scenario's steady state, a root locus over speed, the linear critical speed.
+    Modes(modes::Args),
 }
 
 fn main() {
@@ -42,6 +46,8 @@ fn main() {
         Command::Creep(a) => creep::run(a),
         Command::Plot(a) => plot::run(a),
         Command::Info(a) => info::run(a),
+        Command::Equilibrium(a) => equilibrium::run(a),
+        Command::Modes(a) => modes::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

@@ -499,45 +499,22 @@ struct ScenarioRun {
     columns: columns::Columns,
 }
 
-/// Builds the system of `scenario` on `model` with the engine `equations`:
-/// parameters and initial state, the track, the output columns.
+/// Builds the system of `scenario` on `model` with the engine `equations`
+/// ([`scenario::scenario_system`]) and its output columns.
 fn prepare(
     scenario: &Scenario,
     model: &Model,
     equations: Box<dyn Equations>,
     tables: &ContactTableCache,
 ) -> Result<ScenarioRun, RunError> {
-    let InitialState {
-        params,
-        q: q0,
-        v: v0,
-    } = scenario_state(scenario, model)?;
-    let (equations, breakpoints, binding) =
-        scenario::drive_track_frames(scenario, model, &params, equations, tables)?;
-    let mut system = ModelSystem::new(model, equations, params)?;
-    scenario::check_integrator(&system, &scenario.integrator).map_err(|message| {
-        RunError::Setup {
-            file: scenario.source.clone(),
-            message,
-        }
-    })?;
-    let (q0, v0) = system.initial_state(0.0, &q0, &v0)?;
-    match &binding {
-        Some(b) => system.bind_track(b)?,
-        None => {
-            if let Some(f) = system.forces().iter().find(|f| f.needs_track()) {
-                return Err(RunError::Setup {
-                    file: scenario.source.clone(),
-                    message: format!(
-                        "force element \"{}\" needs a track: put its wheelset on a \
-                         track-following frame and give the scenario a `track`",
-                        f.name()
-                    ),
-                });
-            }
-        }
-    }
-    let arc = binding.as_ref().map(|b| b.speed.clone());
+    let scenario::ScenarioSystem {
+        system,
+        q0,
+        v0,
+        breakpoints,
+        arc,
+        ..
+    } = scenario::scenario_system_sharing(scenario, model, equations, tables)?;
     let columns = columns::columns(model, &system, &scenario.output, &scenario.source, arc)?;
     Ok(ScenarioRun {
         system,

@@ -4,13 +4,17 @@
 
 use super::RunError;
 use crate::Equations;
+use crate::analysis::{
+    self, CoordinateInfo, equilibrium::Equilibrium, equilibrium::EquilibriumSettings,
+};
 use crate::equations::Parts;
 use crate::forces::{ContactTableCache, TrackBinding};
 use crate::inputs::{DrivenEquations, InputProvider};
 use crate::model_system::ModelSystem;
+use crate::system::MechanicalSystem;
 use crate::system::SimError;
 use crate::track_inputs::{RunningSpeed, TrackInputs};
-use railmbs_models::{IntegratorSpec, Model, Scenario};
+use railmbs_models::{InitialStateKind, IntegratorSpec, Model, Scenario};
 
 /// Parameter values and initial state of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,6 +113,106 @@ pub(crate) fn drive_track_frames(
         breakpoints,
         Some(binding),
     ))
+}
+
+/// A scenario's system at its initial state, before any output.
+pub struct ScenarioSystem {
+    /// The model's engine (driven along the track) with its force elements.
+    pub system: ModelSystem,
+    /// Its coordinates, in system order (names, units).
+    pub coordinates: Vec<CoordinateInfo>,
+    /// Initial system coordinates (coordinates, then element states).
+    pub q0: Vec<f64>,
+    /// Their rates.
+    pub v0: Vec<f64>,
+    /// Times of the kinks of the track-following frames, s.
+    pub breakpoints: Vec<f64>,
+    /// The running speed law on a track.
+    pub arc: Option<RunningSpeed>,
+    /// The equilibrium the run starts from (`initial_state: Equilibrium`),
+    /// with the roles of the coordinates.
+    pub equilibrium: Option<Equilibrium>,
+}
+
+/// Builds the system of `scenario` on `model` with the engine `equations`:
+/// parameters and initial state, the track, and, when the scenario asks for
+/// it (`initial_state: Equilibrium`), the equilibrium at t = 0 from that
+/// state (the force elements' states are then accepted there).
+///
+/// # Errors
+/// A bad scenario, or no equilibrium (the message names the scenario file).
+pub fn scenario_system(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+) -> Result<ScenarioSystem, RunError> {
+    scenario_system_sharing(scenario, model, equations, &ContactTableCache::new())
+}
+
+/// [`scenario_system`] with the wheel–rail contact tables of `tables`
+/// (those built here are added): the systems of a sweep over speed or
+/// parameters build each table once.
+pub fn scenario_system_sharing(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    tables: &ContactTableCache,
+) -> Result<ScenarioSystem, RunError> {
+    let setup = |message: String| RunError::Setup {
+        file: scenario.source.clone(),
+        message,
+    };
+    let InitialState {
+        params,
+        q: q0,
+        v: v0,
+    } = scenario_state(scenario, model)?;
+    let (equations, breakpoints, binding) =
+        drive_track_frames(scenario, model, &params, equations, tables)?;
+    let mut system = ModelSystem::new(model, equations, params)?;
+    check_integrator(&system, &scenario.integrator).map_err(setup)?;
+    let (mut q0, mut v0) = system.initial_state(0.0, &q0, &v0)?;
+    match &binding {
+        Some(b) => system.bind_track(b)?,
+        None => {
+            if let Some(f) = system.forces().iter().find(|f| f.needs_track()) {
+                return Err(setup(format!(
+                    "force element \"{}\" needs a track: put its wheelset on a \
+                     track-following frame and give the scenario a `track`",
+                    f.name()
+                )));
+            }
+        }
+    }
+    let coordinates = analysis::coordinates(model, &system);
+    let equilibrium = match scenario.initial_kind {
+        InitialStateKind::Given => None,
+        InitialStateKind::Equilibrium => {
+            let eq = analysis::equilibrium::solve(
+                &mut system,
+                &coordinates,
+                0.0,
+                &q0,
+                &v0,
+                &EquilibriumSettings::default(),
+            )
+            .map_err(|e| setup(format!("initial_state: Equilibrium: {e}")))?;
+            // The force elements' states (anchors, modes) start there.
+            system.accept_step(eq.t, &eq.q, &eq.v)?;
+            q0.clone_from(&eq.q);
+            v0.clone_from(&eq.v);
+            Some(eq)
+        }
+    };
+    Ok(ScenarioSystem {
+        system,
+        coordinates,
+        q0,
+        v0,
+        breakpoints,
+        arc: binding.as_ref().map(|b| b.speed.clone()),
+        equilibrium,
+    })
 }
 
 /// One body velocity vector (v, ω) per body, stacked.

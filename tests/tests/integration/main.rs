@@ -3,6 +3,8 @@
 
 mod dynamics;
 mod equations;
+mod equilibrium;
+mod modes;
 mod plugins;
 mod symbolic;
 mod track_frames;

@@ -1,0 +1,137 @@
+//! `umsim equilibrium SCENARIO [--engine numeric|symbolic] [--plugin FILE]
+//! [--set NAME=VALUE]…`: the static (steady) equilibrium at the scenario's
+//! start (the state `initial_state: Equilibrium` starts a run from): a table
+//! of the coordinates (long names, units, what the solve did with each) and,
+//! for vehicles, the wheel loads Q and lateral forces Y of every wheel.
+
+use crate::engine::{Engine, build_engine};
+use railmbs_models::InitialStateKind;
+use railmbs_runtime::analysis::{self, equilibrium::Role};
+use railmbs_runtime::run::scenario::{ScenarioSystem, scenario_system};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `umsim equilibrium`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Scenario file (RON); its model's `init`/`vel` and the scenario's
+    /// `initial` overrides are the starting guess.
+    pub scenario: PathBuf,
+    /// Which equations of motion to use.
+    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
+    pub engine: Engine,
+    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
+    #[arg(long)]
+    pub plugin: Option<PathBuf>,
+    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
+    pub set: Vec<(String, String)>,
+}
+
+/// Runs `umsim equilibrium`.
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let mut scenario = railmbs_models::load_scenario(&args.scenario)?;
+    for (name, value) in &args.set {
+        scenario.set_parameter(name, value);
+    }
+    scenario.initial_kind = InitialStateKind::Equilibrium;
+    let model = railmbs_models::load_model(&scenario.model)?;
+    let engine = if args.plugin.is_some() {
+        Engine::Symbolic
+    } else {
+        args.engine
+    };
+    let equations = build_engine(&model, engine, args.plugin.as_deref())?;
+    let start = std::time::Instant::now();
+    let mut solved = scenario_system(&scenario, &model, equations)?;
+    let elapsed = start.elapsed().as_secs_f64();
+    print!("{}", report(&mut solved, elapsed)?);
+    Ok(())
+}
+
+/// The tables `umsim equilibrium` prints: coordinates, then wheel loads.
+/// `seconds` is the time the set-up and solve took.
+pub fn report(
+    solved: &mut ScenarioSystem,
+    seconds: f64,
+) -> Result<String, Box<dyn std::error::Error>> {
+    let eq = solved
+        .equilibrium
+        .clone()
+        .ok_or("the scenario system was built without an equilibrium")?;
+    let mut s = String::new();
+    writeln!(
+        s,
+        "equilibrium at t = {} s: {} Newton iterations, largest residual force {:.2e} \
+         (tolerance {:.1e}); solve {:.1} ms (with the set-up of the model, track and contact \
+         tables {:.1} ms)",
+        eq.t,
+        eq.iterations,
+        eq.residual,
+        eq.tolerance,
+        1e3 * eq.seconds,
+        1e3 * seconds
+    )?;
+    let width = solved
+        .coordinates
+        .iter()
+        .map(|c| c.name.len())
+        .max()
+        .unwrap_or(10)
+        .max(10);
+    writeln!(
+        s,
+        "\n{:<width$}  {:<11}  {:>14}  {:>14}  unit",
+        "coordinate", "solve", "value", "change"
+    )?;
+    for (i, c) in solved.coordinates.iter().enumerate() {
+        let (value, change, unit) = match eq.roles[i] {
+            Role::Rate => (eq.v[i], eq.v[i] - eq.v_start[i], c.kind.rate_unit()),
+            _ => (eq.q[i], eq.q[i] - eq.q_start[i], c.kind.unit()),
+        };
+        writeln!(
+            s,
+            "{:<width$}  {:<11}  {value:>14.6e}  {change:>14.3e}  {unit}",
+            c.name,
+            eq.roles[i].describe()
+        )?;
+    }
+    let held: Vec<&str> = solved
+        .coordinates
+        .iter()
+        .zip(&eq.roles)
+        .filter(|(_, r)| **r == Role::Held)
+        .map(|(c, _)| c.name.as_str())
+        .collect();
+    if !held.is_empty() {
+        writeln!(
+            s,
+            "held as given (no force depends on them): {}",
+            held.join(", ")
+        )?;
+    }
+    let loads = analysis::wheel_loads(&mut solved.system, eq.t, &eq.q, &eq.v)?;
+    if !loads.is_empty() {
+        let width = loads.iter().map(|(n, _)| n.len()).max().unwrap_or(7).max(7);
+        writeln!(
+            s,
+            "\n{:<width$}  {:>12}  {:>12}  {:>12}  {:>12}",
+            "wheel–rail", "Q left [kN]", "Y left [kN]", "Q right [kN]", "Y right [kN]"
+        )?;
+        let mut total = 0.0;
+        for (name, w) in &loads {
+            let [(ql, yl), (qr, yr)] = w.loads;
+            total += ql + qr;
+            writeln!(
+                s,
+                "{name:<width$}  {:>12.4}  {:>12.4}  {:>12.4}  {:>12.4}",
+                ql / 1e3,
+                yl / 1e3,
+                qr / 1e3,
+                yr / 1e3
+            )?;
+        }
+        writeln!(s, "sum of wheel loads: {:.4} kN", total / 1e3)?;
+    }
+    Ok(s)
+}

@@ -1,0 +1,291 @@
+//! `umsim modes SCENARIO [--speed FROM:TO:STEP] [-o CSV] [--engine …]
+//! [--plugin FILE] [--set NAME=VALUE]…`: the linear modes of a scenario's
+//! model at its steady state (eigenvalues, frequency, damping ratio, named
+//! by their dominant coordinates; the CSV holds the normalized mode
+//! shapes), or with `--speed` the root locus over speed (CSV: one row per
+//! speed and mode) and the linear critical speed, where the least damped
+//! lateral (hunting) mode's damping ratio crosses zero.
+
+use crate::engine::{Engine, build_engine};
+use railmbs_runtime::analysis::modes::Mode;
+use railmbs_runtime::analysis::speed::{SpeedModes, critical_speed, root_locus, scenario_modes};
+use railmbs_runtime::forces::ContactTableCache;
+use railmbs_runtime::run::RunError;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `umsim modes`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Scenario file (RON): model, track and speed; the steady state is
+    /// found from its initial state (as `umsim equilibrium`).
+    pub scenario: PathBuf,
+    /// A root locus over running speeds `FROM:TO:STEP` (m/s) instead of the
+    /// scenario's own speed.
+    #[arg(long, value_name = "FROM:TO:STEP", value_parser = parse_speeds)]
+    pub speed: Option<Speeds>,
+    /// CSV: the modes with their shapes, or with `--speed` the root locus.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Which equations of motion to use.
+    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
+    pub engine: Engine,
+    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
+    #[arg(long)]
+    pub plugin: Option<PathBuf>,
+    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
+    pub set: Vec<(String, String)>,
+}
+
+/// The running speeds of `--speed`, m/s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Speeds(pub Vec<f64>);
+
+/// The speeds of `FROM:TO:STEP`, m/s: FROM, FROM + STEP, … up to TO
+/// (included when it falls on the grid, to a millionth of a step).
+fn parse_speeds(text: &str) -> Result<Speeds, String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let [from, to, step] = parts[..] else {
+        return Err(format!("expected FROM:TO:STEP in m/s, got {text:?}"));
+    };
+    let number = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("{s:?} in {text:?} is not a finite number"))
+    };
+    let (from, to, step) = (number(from)?, number(to)?, number(step)?);
+    if step <= 0.0 || to < from || from < 0.0 {
+        return Err(format!("{text:?}: need 0 ≤ FROM ≤ TO and STEP > 0 (m/s)"));
+    }
+    let count = ((to - from) / step + 1e-6).floor() as usize + 1;
+    if count > 10_000 {
+        return Err(format!("{text:?} asks for {count} speeds (at most 10000)"));
+    }
+    Ok(Speeds((0..count).map(|k| from + k as f64 * step).collect()))
+}
+
+/// Runs `umsim modes`.
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let mut scenario = railmbs_models::load_scenario(&args.scenario)?;
+    for (name, value) in &args.set {
+        scenario.set_parameter(name, value);
+    }
+    let model = railmbs_models::load_model(&scenario.model)?;
+    let engine = if args.plugin.is_some() {
+        Engine::Symbolic
+    } else {
+        args.engine
+    };
+    let plugin = args.plugin.clone();
+    // Built once (a plugin is compiled or loaded once), then one engine per speed.
+    let mut make = {
+        let model = model.clone();
+        let mut first = Some(build_engine(&model, engine, plugin.as_deref())?);
+        move || -> Result<Box<dyn railmbs_runtime::Equations>, RunError> {
+            match first.take() {
+                Some(e) => Ok(e),
+                None => build_engine(&model, engine, plugin.as_deref())
+                    .map_err(|e| RunError::Sim(railmbs_runtime::SimError::Other(e.to_string()))),
+            }
+        }
+    };
+    match &args.speed {
+        None => {
+            let start = std::time::Instant::now();
+            let one = scenario_modes(&scenario, &model, make()?, &ContactTableCache::new())?;
+            let total = start.elapsed().as_secs_f64();
+            print!("{}", describe(&one, total)?);
+            if let Some(path) = &args.output {
+                write_shapes(path, &one)?;
+                println!("modes and shapes written to {}", path.display());
+            }
+        }
+        Some(Speeds(speeds)) => {
+            let start = std::time::Instant::now();
+            let locus = root_locus(&scenario, &model, speeds, &mut make)?;
+            let total = start.elapsed().as_secs_f64();
+            print!("{}", describe_locus(&locus, total)?);
+            if let Some(path) = &args.output {
+                write_locus(path, &locus)?;
+                println!("root locus written to {}", path.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One line of the modes table.
+fn mode_line(s: &mut String, k: usize, m: &Mode) -> std::fmt::Result {
+    writeln!(
+        s,
+        "{k:>4}  {:>9.4}  {:>9.4}  {:>9.4}  {:>11.4e}  {:>10.4}  {}",
+        m.frequency, m.natural_frequency, m.damping_ratio, m.re, m.im, m.name
+    )
+}
+
+/// The table of the modes at one speed.
+pub fn describe(one: &SpeedModes, seconds: f64) -> Result<String, std::fmt::Error> {
+    let mut s = String::new();
+    let [eq, lin, eig] = one.seconds;
+    writeln!(
+        s,
+        "modes at {} m/s: {} states ({} positions left out: nothing depends on them), {} modes \
+         and {} zero eigenvalues ({}); \
+         equilibrium {:.1} ms (with the set-up {:.1} ms), linearization {:.1} ms, \
+         eigendecomposition {:.1} ms, total {:.1} ms",
+        one.speed,
+        one.linearization.a.nrows(),
+        one.linearization.left_out.len(),
+        one.modes.modes.len(),
+        one.modes.zero_modes.len(),
+        if one.modes.zero_modes.is_empty() {
+            "none".to_string()
+        } else {
+            one.modes.zero_modes.join("; ")
+        },
+        1e3 * one.equilibrium.seconds,
+        1e3 * eq,
+        1e3 * lin,
+        1e3 * eig,
+        1e3 * seconds
+    )?;
+    writeln!(
+        s,
+        "\nmode  f [Hz]     fn [Hz]    zeta [-]   Re [1/s]     Im [rad/s]  dominant coordinates"
+    )?;
+    for (k, m) in one.modes.modes.iter().enumerate() {
+        mode_line(&mut s, k + 1, m)?;
+    }
+    if let Some(m) = one.modes.least_damped_lateral() {
+        writeln!(
+            s,
+            "\nleast damped lateral mode: {} at {:.4} Hz, damping ratio {:.4}",
+            m.name, m.frequency, m.damping_ratio
+        )?;
+    }
+    Ok(s)
+}
+
+/// The summary of a root locus: the least damped lateral mode per speed and
+/// the critical speed.
+pub fn describe_locus(locus: &[SpeedModes], seconds: f64) -> Result<String, std::fmt::Error> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "root locus at {} speeds in {:.2} s\n\nspeed [m/s]  f [Hz]     zeta [-]   least damped lateral mode",
+        locus.len(),
+        seconds
+    )?;
+    for one in locus {
+        match one.modes.least_damped_lateral() {
+            Some(m) => writeln!(
+                s,
+                "{:>11.3}  {:>9.4}  {:>9.4}  {}",
+                one.speed, m.frequency, m.damping_ratio, m.name
+            )?,
+            None => writeln!(s, "{:>11.3}  (no lateral mode)", one.speed)?,
+        }
+    }
+    match critical_speed(locus) {
+        Some(v) => writeln!(
+            s,
+            "\nlinear critical speed: {v:.3} m/s ({:.1} km/h)",
+            3.6 * v
+        )?,
+        None => writeln!(
+            s,
+            "\nno linear critical speed in this range (the least damped lateral mode's damping \
+             ratio does not cross zero)"
+        )?,
+    }
+    Ok(s)
+}
+
+fn csv_error(path: &std::path::Path, e: impl std::fmt::Display) -> String {
+    format!("{}: {e}", path.display())
+}
+
+/// The modes at one speed with their normalized shapes: a row per mode,
+/// `<coordinate>.re`/`.im` columns.
+fn write_shapes(
+    path: &std::path::Path,
+    one: &SpeedModes,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
+    let mut header: Vec<String> = [
+        "mode",
+        "f[Hz]",
+        "fn[Hz]",
+        "zeta[-]",
+        "Re[1/s]",
+        "Im[rad/s]",
+        "name",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for c in &one.coordinates {
+        header.push(format!("{}.re", c.name));
+        header.push(format!("{}.im", c.name));
+    }
+    w.write_record(&header).map_err(|e| csv_error(path, e))?;
+    for (k, m) in one.modes.modes.iter().enumerate() {
+        let mut row = vec![
+            (k + 1).to_string(),
+            format!("{:?}", m.frequency),
+            format!("{:?}", m.natural_frequency),
+            format!("{:?}", m.damping_ratio),
+            format!("{:?}", m.re),
+            format!("{:?}", m.im),
+            m.name.clone(),
+        ];
+        for (re, im) in &m.shape {
+            row.push(format!("{re:?}"));
+            row.push(format!("{im:?}"));
+        }
+        w.write_record(&row).map_err(|e| csv_error(path, e))?;
+    }
+    w.flush().map_err(|e| csv_error(path, e))?;
+    Ok(())
+}
+
+/// The root locus: a row per speed and mode.
+fn write_locus(
+    path: &std::path::Path,
+    locus: &[SpeedModes],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
+    w.write_record([
+        "speed[m/s]",
+        "mode",
+        "f[Hz]",
+        "fn[Hz]",
+        "zeta[-]",
+        "Re[1/s]",
+        "Im[rad/s]",
+        "lateral",
+        "name",
+    ])
+    .map_err(|e| csv_error(path, e))?;
+    for one in locus {
+        for (k, m) in one.modes.modes.iter().enumerate() {
+            w.write_record([
+                format!("{:?}", one.speed),
+                (k + 1).to_string(),
+                format!("{:?}", m.frequency),
+                format!("{:?}", m.natural_frequency),
+                format!("{:?}", m.damping_ratio),
+                format!("{:?}", m.re),
+                format!("{:?}", m.im),
+                u8::from(m.is_lateral()).to_string(),
+                m.name.clone(),
+            ])
+            .map_err(|e| csv_error(path, e))?;
+        }
+    }
+    w.flush().map_err(|e| csv_error(path, e))?;
+    Ok(())
+}

@@ -1,0 +1,140 @@
+//! A scenario's modes at its running speed and over a range of speeds (the
+//! root locus), and the linear critical speed: at each speed the steady
+//! state on the scenario's track ([`super::equilibrium`]), the
+//! linearization there ([`super::linear`]) and its modes
+//! ([`super::modes`]).
+
+use super::CoordinateInfo;
+use super::equilibrium::{Equilibrium, Role};
+use super::linear::{Linearization, linearize};
+use super::modes::{Modes, modes, zero_crossing};
+use crate::Equations;
+use crate::forces::ContactTableCache;
+use crate::run::RunError;
+use crate::run::scenario::{ScenarioSystem, scenario_system_sharing};
+use railmbs_models::{InitialStateKind, Model, Scenario};
+use std::time::Instant;
+
+/// The modes of a scenario at one speed.
+#[derive(Debug, Clone)]
+pub struct SpeedModes {
+    /// Running speed, m/s (0 off a track).
+    pub speed: f64,
+    /// The system's coordinates (names, units), in system order.
+    pub coordinates: Vec<CoordinateInfo>,
+    /// The steady state linearized about.
+    pub equilibrium: Equilibrium,
+    /// The linear system there.
+    pub linearization: Linearization,
+    /// Its modes.
+    pub modes: Modes,
+    /// Wall-clock seconds of the equilibrium solve, of the linearization
+    /// and of the eigendecomposition (benchmark figures).
+    pub seconds: [f64; 3],
+}
+
+/// `scenario` run at the constant speed `speed` (m/s) from its steady state:
+/// the track's speed set (a speed profile dropped), the model parameter
+/// `v0` (the wheels' initial spin v0/r0 in the bundled vehicles: the guess
+/// of their rolling rate) set to it when the model has one.
+pub fn at_speed(scenario: &Scenario, model: &Model, speed: f64) -> Scenario {
+    let mut s = scenario.clone();
+    if let Some(track) = &mut s.track {
+        track.speed = speed;
+        track.speed_profile.clear();
+    }
+    if model.parameter_index("v0").is_some() {
+        s.set_parameter("v0", &format!("{speed:?}"));
+    }
+    s.initial_kind = InitialStateKind::Equilibrium;
+    s
+}
+
+/// The modes of `scenario` (at its steady state, see [`at_speed`] for the
+/// speed) with the engine `equations`, sharing the contact tables `tables`.
+///
+/// # Errors
+/// A bad scenario, no equilibrium, or a failed linearization or
+/// eigendecomposition.
+pub fn scenario_modes(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    tables: &ContactTableCache,
+) -> Result<SpeedModes, RunError> {
+    let mut s = scenario.clone();
+    s.initial_kind = InitialStateKind::Equilibrium;
+    let start = Instant::now();
+    let ScenarioSystem {
+        mut system,
+        coordinates,
+        equilibrium,
+        ..
+    } = scenario_system_sharing(&s, model, equations, tables)?;
+    let setup = start.elapsed().as_secs_f64();
+    let eq = equilibrium.expect("an equilibrium was asked for");
+    let start = Instant::now();
+    let left_out: Vec<usize> = (0..eq.roles.len())
+        .filter(|&i| eq.roles[i] != Role::Position)
+        .collect();
+    let lin = linearize(
+        &mut system,
+        &coordinates,
+        (eq.t, &eq.q, &eq.v),
+        &eq.lambda,
+        &left_out,
+    )?;
+    let linearized = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let modes = modes(&lin, &coordinates)?;
+    let decomposed = start.elapsed().as_secs_f64();
+    Ok(SpeedModes {
+        speed: s.track.as_ref().map_or(0.0, |t| t.speed),
+        coordinates,
+        equilibrium: eq,
+        linearization: lin,
+        modes,
+        seconds: [setup, linearized, decomposed],
+    })
+}
+
+/// The modes of `scenario` at each of `speeds` (m/s), each from its own
+/// steady state; `engine` makes a fresh engine for each (the contact tables
+/// are built once).
+///
+/// # Errors
+/// As [`scenario_modes`], naming the speed.
+pub fn root_locus(
+    scenario: &Scenario,
+    model: &Model,
+    speeds: &[f64],
+    engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
+) -> Result<Vec<SpeedModes>, RunError> {
+    let tables = ContactTableCache::new();
+    speeds
+        .iter()
+        .map(|&v| {
+            let s = at_speed(scenario, model, v);
+            scenario_modes(&s, model, engine()?, &tables).map_err(|e| RunError::Setup {
+                file: scenario.source.clone(),
+                message: format!("at {v} m/s: {e}"),
+            })
+        })
+        .collect()
+}
+
+/// The linear critical speed of a root locus (sorted by speed), m/s: where
+/// the damping ratio of the least damped lateral mode
+/// ([`Modes::least_damped_lateral`]) first crosses zero, interpolated
+/// linearly between the two speeds around it.
+pub fn critical_speed(locus: &[SpeedModes]) -> Option<f64> {
+    let samples: Vec<(f64, f64)> = locus
+        .iter()
+        .filter_map(|s| {
+            s.modes
+                .least_damped_lateral()
+                .map(|m| (s.speed, m.damping_ratio))
+        })
+        .collect();
+    zero_crossing(&samples)
+}
