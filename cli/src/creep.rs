@@ -5,7 +5,8 @@
 //! ```
 //!
 //! `LAW` is a creep law in the syntax of `umsim bench --creep` and of
-//! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]`,
+//! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]` (Pogorelov
+//! 2005, Sect. 4.2), `mueller-kalker-saturated[:EXPONENT]`,
 //! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
 //! `,sliding=continuation|integrated|picard` and `,nodes=K`,
 //! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`;
@@ -40,11 +41,12 @@ pub enum Sliding {
 /// The long help of a creep-law argument (`umsim creep --method`, `umsim bench
 /// --creep`): the syntax of [`CreepLawSpec`]'s `FromStr` and its defaults.
 pub(crate) const LAW_HELP: &str = concat!(
-    "Creep-force law and its settings: kalker | mueller[:EXPONENT] | ",
+    "Creep-force law and its settings: kalker | mueller[:EXPONENT] (Pogorelov 2005) | ",
+    "mueller-kalker-saturated[:EXPONENT] | ",
     "fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY | ",
     "fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | ",
     "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]. ",
-    "Defaults: Mueller exponent 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
+    "Defaults: Mueller exponents 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
     "continuation sliding (8 Gauss nodes for integrated/picard), Polach ",
     "ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated"
 );
@@ -254,7 +256,14 @@ mod tests {
         let input = "xi,eta,phi,a,b,G,nu,mu,N\n\
                      0.001,0,0,0.006,0.004,8e10,0.28,0.3,80000\n\
                      0,0,0,0.006,0.004,8e10,0.28,0.3,80000\n";
-        for m in ["kalker", "mueller", "fastsim:10", "fastsim-a:10", "polach"] {
+        for m in [
+            "kalker",
+            "mueller",
+            "mueller-kalker-saturated",
+            "fastsim:10",
+            "fastsim-a:10",
+            "polach",
+        ] {
             let out = run_str(m, input).unwrap();
             let lines: Vec<&str> = out.lines().collect();
             assert_eq!(lines[0], "Fx,Fy,Mz");
@@ -400,6 +409,7 @@ mod tests {
             "kalker",
             "mueller",
             "mueller:3",
+            "mueller-kalker-saturated:2.5",
             "fastsim",
             "fastsim:20",
             "fastsim-a",

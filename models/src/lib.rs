@@ -297,7 +297,9 @@
 //!           mu: 0.4, young: 2.1e11, poisson: 0.28, normal_damping: 0,        // -, Pa, -, N s/m
 //!           creep: FastsimA(strips: 20, sliding: Continuation),   // default
 //!           // or FastsimA(strips: 20, sliding: Integrated(nodes: 8))   accurate at flange spin
-//!           // or Fastsim(nx: 10, ny: 10) | Kalker | Mueller(exponent: 2)
+//!           // or Fastsim(nx: 10, ny: 10) | Kalker
+//!           // or Mueller(exponent: 2)   Pogorelov 2005, Sect. 4.2 (load-dependent slope, sliding flange)
+//!           // or MuellerKalkerSaturated(exponent: 2)   Kalker's linear force saturated towards μN
 //!           // or Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))   (A, B s/m), optional
 //!           // (railmbs_wheelrail::creep::CreepLawSpec; its real settings may be expressions)
 //!           rail: Rigid,                      // or Elastic(ky: .., cy: .., kz: .., cz: ..)  N/m, N s/m

@@ -7,8 +7,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller, Polach,
-    SlidingZone,
+    ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, KalkerLinear, Mueller,
+    MuellerKalkerSaturated, Polach, SlidingZone,
 };
 use std::hint::black_box;
 
@@ -37,6 +37,10 @@ fn bench(c: &mut Criterion) {
     let laws: Vec<(String, Box<dyn CreepLaw>)> = vec![
         ("kalker".into(), Box::new(KalkerLinear)),
         ("mueller".into(), Box::new(Mueller::default())),
+        (
+            "mueller-kalker-saturated".into(),
+            Box::new(MuellerKalkerSaturated::default()),
+        ),
         (
             "fastsim 10x10".into(),
             Box::new(Fastsim::new(10, 10).unwrap()),

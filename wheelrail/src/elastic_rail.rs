@@ -59,7 +59,7 @@
 //! two-point contact), [`LinearizedContacts`] to first order from the contacts
 //! at zero displacement.
 
-use crate::creep::{ContactPatch, CreepForces, CreepLaw, Creepages};
+use crate::creep::{ContactMode, ContactPatch, CreepForces, CreepLaw, Creepages};
 use crate::geometry::{Contact, ContactGeometry};
 use crate::hertz::HertzShape;
 use crate::kalker::KalkerCoefficients;
@@ -552,12 +552,25 @@ pub fn solve_from(
         let vel = rail_velocity(d, d_prev, settings.h);
         let mut change = 0.0_f64;
         let mut scale = 0.0_f64;
+        // One- or two-point contact, for the laws that treat the flange
+        // contact apart; the contact angle in the rail's cross-section.
+        let loaded = |i: usize| i < n_contacts && normal[i] > 0.0;
+        let angle = |i: usize| geo[i].normal[0].abs().atan2(geo[i].normal[1]);
+        let modes = ContactMode::of_wheel([angle(0), angle(1)], [loaded(0), loaded(1)]);
         for i in 0..n_contacts {
             let c = &geo[i];
             let [ny, nz] = c.normal;
             let t = [nz, -ny];
-            let (f, lateral_slope) =
-                creep_force(i, c, normal[i], material, law, vel, t, settings.v_roll)?;
+            let (f, lateral_slope) = creep_force(
+                i,
+                c,
+                (normal[i], modes[i]),
+                material,
+                law,
+                vel,
+                t,
+                settings.v_roll,
+            )?;
             change = change.max((f.fy - creep[i].fy).abs().max((f.fx - creep[i].fx).abs()));
             scale = scale.max(normal[i]);
             creep[i] = f;
@@ -648,7 +661,7 @@ fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
     }
 }
 
-/// Creep forces of contact `i` for normal force `nn`; the rail's velocity
+/// Creep forces of contact `i` for normal force `nn` in `mode`; the rail's velocity
 /// `vel` moves the rail's material point, `Δη = −(vel·t)/V`. Also −∂T/∂η (N)
 /// of the lateral creep force: Kalker's f₂₂ = G a b C₂₂ scaled by the
 /// saturation |F|/|F_linear| (≤ 1) of the law's force; 0 without load or
@@ -657,7 +670,7 @@ fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
 fn creep_force(
     i: usize,
     c: &RailContact,
-    nn: f64,
+    (nn, mode): (f64, ContactMode),
     material: &ContactMaterial,
     law: &dyn CreepLaw,
     vel: [f64; 2],
@@ -683,7 +696,7 @@ fn creep_force(
     // At the rolling speed, for laws whose friction falls with the slip
     // velocity (Polach).
     let f = law
-        .forces_at_speed(&patch, &cr, v_roll)
+        .forces_in_contact(&patch, &cr, v_roll, mode)
         .map_err(|e| contact_err(i, e))?;
     let lateral_slope = KalkerCoefficients::saturated_slopes(
         hc.a,

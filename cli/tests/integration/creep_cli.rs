@@ -60,7 +60,7 @@ fn every_method_reproduces_linear_theory_and_saturation() {
             vec!["--law", "fastsim-a:strips=20,sliding=integrated,nodes=8"],
             0.02,
         ),
-        (vec!["--method", "mueller:3"], 1e-6),
+        (vec!["--method", "mueller-kalker-saturated:3"], 1e-6),
         (
             vec![
                 "--method",

@@ -18,7 +18,7 @@ use std::str::FromStr;
 
 use super::{
     CreepError, CreepLaw, Fastsim, FastsimA, INTEGRATED_NODES, KalkerLinear, MUELLER_EXPONENT,
-    Mueller, Polach, SlidingZone,
+    Mueller, MuellerKalkerSaturated, Polach, SlidingZone,
 };
 
 /// Default number of strips of FastSim_A when a command line leaves it out
@@ -42,7 +42,8 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// | text | law |
 /// |---|---|
 /// | `kalker` | [`KalkerLinear`] |
-/// | `mueller`, `mueller:3`, `mueller:exponent=3` | [`Mueller`], exponent default [`MUELLER_EXPONENT`] |
+/// | `mueller`, `mueller:3`, `mueller:exponent=3` | [`Mueller`] (Pogorelov 2005, Sect. 4.2), exponent default [`MUELLER_EXPONENT`] |
+/// | `mueller-kalker-saturated[:EXPONENT]` | [`MuellerKalkerSaturated`], exponent default [`MUELLER_EXPONENT`] |
 /// | `fastsim`, `fastsim:20` (20 × 20), `fastsim:nx=20,ny=10` | [`Fastsim`], `nx` elements per strip, `ny` strips, default [`FASTSIM_DIVISIONS`] each |
 /// | `fastsim-a`, `fastsim-a:20`, `fastsim-a:strips=20,sliding=integrated,nodes=8` | [`FastsimA`], default [`FASTSIM_A_STRIPS`] strips, sliding `continuation` (default), `integrated` or `picard` with `nodes` Gauss nodes (default [`INTEGRATED_NODES`]) |
 /// | `fastsim-a-integrated[:STRIPS]` | `fastsim-a:strips=STRIPS,sliding=integrated` |
@@ -55,12 +56,13 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// # Model-file syntax (RON, feature `serde`)
 ///
 /// ```text
-/// Kalker | Mueller(exponent: 2) | Fastsim(nx: 10, ny: 10)
+/// Kalker | Mueller(exponent: 2) | MuellerKalkerSaturated(exponent: 2)
+/// Fastsim(nx: 10, ny: 10)
 /// FastsimA(strips: 20, sliding: Continuation)      // or Integrated(nodes: 8), Picard(nodes: 8)
 /// Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))
 /// ```
 ///
-/// `Mueller`'s exponent, `FastsimA`'s sliding and all of `Polach`'s settings
+/// The Mueller laws' exponent, `FastsimA`'s sliding and all of `Polach`'s settings
 /// may be left out (their defaults as above); `Fastsim`'s `nx`, `ny` and
 /// `FastsimA`'s `strips` must be given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,8 +80,18 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 pub enum CreepLawSpec<N = f64> {
     /// Kalker's linear theory, no saturation ([`KalkerLinear`]).
     Kalker,
-    /// Kalker's linear forces saturated towards `μN` ([`Mueller`]).
+    /// Mueller's method as Pogorelov 2005, Sect. 4.2 gives it ([`Mueller`]):
+    /// empirical load-dependent slope, pure sliding at the flange contact of
+    /// a two-point contact.
     Mueller {
+        /// Exponent `m` of the saturation, – (> 0; default [`MUELLER_EXPONENT`]).
+        #[cfg_attr(feature = "serde", serde(default = "serde_impl::mueller_exponent"))]
+        exponent: N,
+    },
+    /// Kalker's linear forces saturated towards `μN`
+    /// ([`MuellerKalkerSaturated`]; this project's `Mueller` before the
+    /// paper's law came).
+    MuellerKalkerSaturated {
         /// Exponent `n` of the saturation, – (> 0; default [`MUELLER_EXPONENT`]).
         #[cfg_attr(feature = "serde", serde(default = "serde_impl::mueller_exponent"))]
         exponent: N,
@@ -138,11 +150,12 @@ impl<N> Default for CreepLawSpec<N> {
 
 impl<N> CreepLawSpec<N> {
     /// The law's short name, as on the command line (`kalker`, `mueller`,
-    /// `fastsim`, `fastsim-a`, `polach`).
+    /// `mueller-kalker-saturated`, `fastsim`, `fastsim-a`, `polach`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::Kalker => "kalker",
             Self::Mueller { .. } => "mueller",
+            Self::MuellerKalkerSaturated { .. } => "mueller-kalker-saturated",
             Self::Fastsim { .. } => "fastsim",
             Self::FastsimA { .. } => "fastsim-a",
             Self::Polach { .. } => "polach",
@@ -168,6 +181,9 @@ impl<N> CreepLawSpec<N> {
         Ok(match self {
             Self::Kalker => CreepLawSpec::Kalker,
             Self::Mueller { exponent } => CreepLawSpec::Mueller {
+                exponent: f("exponent", exponent)?,
+            },
+            Self::MuellerKalkerSaturated { exponent } => CreepLawSpec::MuellerKalkerSaturated {
                 exponent: f("exponent", exponent)?,
             },
             Self::Fastsim { nx, ny } => CreepLawSpec::Fastsim { nx: *nx, ny: *ny },
@@ -197,7 +213,9 @@ impl<N> CreepLawSpec<N> {
     pub fn for_each_value_mut(&mut self, mut f: impl FnMut(&'static str, &mut N)) {
         match self {
             Self::Kalker | Self::Fastsim { .. } | Self::FastsimA { .. } => {}
-            Self::Mueller { exponent } => f("exponent", exponent),
+            Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
+                f("exponent", exponent)
+            }
             Self::Polach {
                 ka,
                 ks,
@@ -247,6 +265,9 @@ impl CreepLawSpec<f64> {
         Ok(match *self {
             Self::Kalker => Box::new(KalkerLinear),
             Self::Mueller { exponent } => Box::new(Mueller::new(exponent)?),
+            Self::MuellerKalkerSaturated { exponent } => {
+                Box::new(MuellerKalkerSaturated::new(exponent)?)
+            }
             Self::Fastsim { nx, ny } => Box::new(Fastsim::new(ny, nx)?),
             Self::FastsimA { strips, sliding } => {
                 Box::new(FastsimA::new(strips)?.with_sliding(sliding)?)
@@ -279,7 +300,9 @@ impl<N: Display> Display for CreepLawSpec<N> {
         f.write_str(self.name())?;
         match self {
             Self::Kalker => Ok(()),
-            Self::Mueller { exponent } => write!(f, ":exponent={exponent}"),
+            Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
+                write!(f, ":exponent={exponent}")
+            }
             Self::Fastsim { nx, ny } => write!(f, ":nx={nx},ny={ny}"),
             Self::FastsimA { strips, sliding } => {
                 write!(f, ":strips={strips},sliding=")?;
@@ -316,7 +339,8 @@ pub struct ParseCreepLawError {
 }
 
 /// The syntax, for error messages and command-line help.
-pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | fastsim[:N] | \
+pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | \
+     mueller-kalker-saturated[:EXPONENT] | fastsim[:N] | \
      fastsim:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
      fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]";
 
@@ -368,7 +392,7 @@ impl FromStr for CreepLawSpec<f64> {
         // (key, the key a bare value stands for): the keys each law accepts.
         let (keys, bare): (&[&str], Option<&str>) = match name {
             "kalker" => (&[], None),
-            "mueller" => (&["exponent"], Some("exponent")),
+            "mueller" | "mueller-kalker-saturated" => (&["exponent"], Some("exponent")),
             "fastsim" => (&["nx", "ny"], Some("nx,ny")),
             "fastsim-a" | "fastsim-a-integrated" => {
                 (&["strips", "sliding", "nodes"], Some("strips"))
@@ -427,12 +451,17 @@ impl FromStr for CreepLawSpec<f64> {
         };
         let spec = match name {
             "kalker" => Self::Kalker,
-            "mueller" => Self::Mueller {
-                exponent: match get("exponent") {
+            "mueller" | "mueller-kalker-saturated" => {
+                let exponent = match get("exponent") {
                     Some(v) => real("exponent", v)?,
                     None => MUELLER_EXPONENT,
-                },
-            },
+                };
+                if name == "mueller" {
+                    Self::Mueller { exponent }
+                } else {
+                    Self::MuellerKalkerSaturated { exponent }
+                }
+            }
             "fastsim" => Self::Fastsim {
                 nx: count("nx", FASTSIM_DIVISIONS)?,
                 ny: count("ny", FASTSIM_DIVISIONS)?,
@@ -543,6 +572,10 @@ mod tests {
         assert_eq!(parse("kalker"), CreepLawSpec::Kalker);
         assert_eq!(parse("mueller"), CreepLawSpec::mueller());
         assert_eq!(parse("mueller:3"), CreepLawSpec::Mueller { exponent: 3.0 });
+        assert_eq!(
+            parse("mueller-kalker-saturated:exponent=3"),
+            CreepLawSpec::MuellerKalkerSaturated { exponent: 3.0 }
+        );
         assert_eq!(parse("fastsim"), CreepLawSpec::fastsim());
         assert_eq!(
             parse("fastsim:20"),
@@ -597,6 +630,7 @@ mod tests {
             CreepLawSpec::Kalker,
             CreepLawSpec::mueller(),
             CreepLawSpec::Mueller { exponent: 2.5 },
+            CreepLawSpec::MuellerKalkerSaturated { exponent: 2.0 },
             CreepLawSpec::fastsim(),
             CreepLawSpec::Fastsim { nx: 40, ny: 7 },
             CreepLawSpec::default(),
@@ -739,6 +773,10 @@ mod tests {
         assert_eq!(
             read("Mueller(exponent: 3)"),
             CreepLawSpec::Mueller { exponent: 3.0 }
+        );
+        assert_eq!(
+            read("MuellerKalkerSaturated()"),
+            parse("mueller-kalker-saturated")
         );
         assert_eq!(
             read("Fastsim(nx: 10, ny: 20)"),

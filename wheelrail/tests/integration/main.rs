@@ -8,5 +8,6 @@ mod creepage;
 mod elastic_rail;
 mod geometry_contact;
 mod hertz;
+mod mueller;
 mod polach;
 mod profile_reading;
