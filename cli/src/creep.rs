@@ -7,7 +7,8 @@
 //! `LAW` is a creep law in the syntax of `umsim bench --creep` and of
 //! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]` (Pogorelov
 //! 2005, Sect. 4.2), `mueller-kalker-saturated[:EXPONENT]`,
-//! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
+//! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-sa[:N]` or
+//! `fastsim-sa:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
 //! `,sliding=continuation|integrated|picard` and `,nodes=K`,
 //! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`;
 //! defaults as in model files. FastSim_A's `integrated` sliding zones are more
@@ -44,6 +45,7 @@ pub(crate) const LAW_HELP: &str = concat!(
     "Creep-force law and its settings: kalker | mueller[:EXPONENT] (Pogorelov 2005) | ",
     "mueller-kalker-saturated[:EXPONENT] | ",
     "fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY | ",
+    "fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY (FastSim_SA: analytic adhesion, FASTSIM sliding) | ",
     "fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | ",
     "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]. ",
     "Defaults: Mueller exponents 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
@@ -412,6 +414,7 @@ mod tests {
             "mueller-kalker-saturated:2.5",
             "fastsim",
             "fastsim:20",
+            "fastsim-sa:nx=30,ny=12",
             "fastsim-a",
             "fastsim-a-integrated:12",
             "fastsim-a:sliding=picard",

@@ -19,6 +19,8 @@
 //! - [`Fastsim`]: Kalker's FASTSIM algorithm (simplified theory);
 //! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (Pogorelov 2005, Sect. 4.3):
 //!   closed-form strips, cost proportional to the number of strips only;
+//! - [`FastsimSa`]: FastSim_SA (Pogorelov 2005, Sect. 4.3, Fig. 24): the
+//!   analytic adhesion zone, FASTSIM's elements in the sliding zone;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
 //!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
 //!
@@ -27,6 +29,7 @@
 
 mod fastsim;
 mod fastsim_a;
+mod fastsim_sa;
 mod kalker_linear;
 mod mueller;
 mod mueller_kalker_saturated;
@@ -35,6 +38,7 @@ mod spec;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
+pub use fastsim_sa::FastsimSa;
 pub use kalker_linear::KalkerLinear;
 pub use mueller::{MUELLER_MAX_LOAD, Mueller};
 pub use mueller_kalker_saturated::{MUELLER_EXPONENT, MuellerKalkerSaturated};

@@ -17,8 +17,8 @@ use std::fmt::{self, Display};
 use std::str::FromStr;
 
 use super::{
-    CreepError, CreepLaw, Fastsim, FastsimA, INTEGRATED_NODES, KalkerLinear, MUELLER_EXPONENT,
-    Mueller, MuellerKalkerSaturated, Polach, SlidingZone,
+    CreepError, CreepLaw, Fastsim, FastsimA, FastsimSa, INTEGRATED_NODES, KalkerLinear,
+    MUELLER_EXPONENT, Mueller, MuellerKalkerSaturated, Polach, SlidingZone,
 };
 
 /// Default number of strips of FastSim_A when a command line leaves it out
@@ -45,6 +45,7 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// | `mueller`, `mueller:3`, `mueller:exponent=3` | [`Mueller`] (Pogorelov 2005, Sect. 4.2), exponent default [`MUELLER_EXPONENT`] |
 /// | `mueller-kalker-saturated[:EXPONENT]` | [`MuellerKalkerSaturated`], exponent default [`MUELLER_EXPONENT`] |
 /// | `fastsim`, `fastsim:20` (20 × 20), `fastsim:nx=20,ny=10` | [`Fastsim`], `nx` elements per strip, `ny` strips, default [`FASTSIM_DIVISIONS`] each |
+/// | `fastsim-sa`, `fastsim-sa:20` (20 × 20), `fastsim-sa:nx=20,ny=10` | [`FastsimSa`], `nx` FASTSIM elements per strip (in the sliding zone), `ny` strips, default [`FASTSIM_DIVISIONS`] each |
 /// | `fastsim-a`, `fastsim-a:20`, `fastsim-a:strips=20,sliding=integrated,nodes=8` | [`FastsimA`], default [`FASTSIM_A_STRIPS`] strips, sliding `continuation` (default), `integrated` or `picard` with `nodes` Gauss nodes (default [`INTEGRATED_NODES`]) |
 /// | `fastsim-a-integrated[:STRIPS]` | `fastsim-a:strips=STRIPS,sliding=integrated` |
 /// | `polach`, `polach:ka=0.5,ks=0.3,friction_decrease=0.4/0.6` | [`Polach`], `ka`, `ks` default 1, `friction_decrease` = `A/B` (B in s/m) optional |
@@ -57,13 +58,13 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 ///
 /// ```text
 /// Kalker | Mueller(exponent: 2) | MuellerKalkerSaturated(exponent: 2)
-/// Fastsim(nx: 10, ny: 10)
+/// Fastsim(nx: 10, ny: 10) | FastsimSa(nx: 10, ny: 10)
 /// FastsimA(strips: 20, sliding: Continuation)      // or Integrated(nodes: 8), Picard(nodes: 8)
 /// Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))
 /// ```
 ///
 /// The Mueller laws' exponent, `FastsimA`'s sliding and all of `Polach`'s settings
-/// may be left out (their defaults as above); `Fastsim`'s `nx`, `ny` and
+/// may be left out (their defaults as above); `Fastsim`'s and `FastsimSa`'s `nx`, `ny` and
 /// `FastsimA`'s `strips` must be given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -99,6 +100,15 @@ pub enum CreepLawSpec<N = f64> {
     /// Kalker's FASTSIM ([`Fastsim`]) in its strip layout, parabolic bound.
     Fastsim {
         /// Elements per strip, in the rolling direction (≥ 1).
+        nx: usize,
+        /// Strips across the ellipse (≥ 1).
+        ny: usize,
+    },
+    /// FastSim_SA ([`FastsimSa`]): analytic adhesion zone, FASTSIM's
+    /// elements in the sliding zone.
+    FastsimSa {
+        /// FASTSIM elements per strip, in the rolling direction (≥ 1); the
+        /// sliding zone gets elements no longer than `2a_y/nx`.
         nx: usize,
         /// Strips across the ellipse (≥ 1).
         ny: usize,
@@ -157,6 +167,7 @@ impl<N> CreepLawSpec<N> {
             Self::Mueller { .. } => "mueller",
             Self::MuellerKalkerSaturated { .. } => "mueller-kalker-saturated",
             Self::Fastsim { .. } => "fastsim",
+            Self::FastsimSa { .. } => "fastsim-sa",
             Self::FastsimA { .. } => "fastsim-a",
             Self::Polach { .. } => "polach",
         }
@@ -187,6 +198,7 @@ impl<N> CreepLawSpec<N> {
                 exponent: f("exponent", exponent)?,
             },
             Self::Fastsim { nx, ny } => CreepLawSpec::Fastsim { nx: *nx, ny: *ny },
+            Self::FastsimSa { nx, ny } => CreepLawSpec::FastsimSa { nx: *nx, ny: *ny },
             Self::FastsimA { strips, sliding } => CreepLawSpec::FastsimA {
                 strips: *strips,
                 sliding: *sliding,
@@ -212,7 +224,10 @@ impl<N> CreepLawSpec<N> {
     /// mutably: to rewrite expressions in place.
     pub fn for_each_value_mut(&mut self, mut f: impl FnMut(&'static str, &mut N)) {
         match self {
-            Self::Kalker | Self::Fastsim { .. } | Self::FastsimA { .. } => {}
+            Self::Kalker
+            | Self::Fastsim { .. }
+            | Self::FastsimSa { .. }
+            | Self::FastsimA { .. } => {}
             Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
                 f("exponent", exponent)
             }
@@ -269,6 +284,7 @@ impl CreepLawSpec<f64> {
                 Box::new(MuellerKalkerSaturated::new(exponent)?)
             }
             Self::Fastsim { nx, ny } => Box::new(Fastsim::new(ny, nx)?),
+            Self::FastsimSa { nx, ny } => Box::new(FastsimSa::new(ny, nx)?),
             Self::FastsimA { strips, sliding } => {
                 Box::new(FastsimA::new(strips)?.with_sliding(sliding)?)
             }
@@ -303,7 +319,9 @@ impl<N: Display> Display for CreepLawSpec<N> {
             Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
                 write!(f, ":exponent={exponent}")
             }
-            Self::Fastsim { nx, ny } => write!(f, ":nx={nx},ny={ny}"),
+            Self::Fastsim { nx, ny } | Self::FastsimSa { nx, ny } => {
+                write!(f, ":nx={nx},ny={ny}")
+            }
             Self::FastsimA { strips, sliding } => {
                 write!(f, ":strips={strips},sliding=")?;
                 match sliding {
@@ -341,7 +359,7 @@ pub struct ParseCreepLawError {
 /// The syntax, for error messages and command-line help.
 pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | \
      mueller-kalker-saturated[:EXPONENT] | fastsim[:N] | \
-     fastsim:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
+     fastsim:nx=NX,ny=NY | fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
      fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]";
 
 /// One `key=value` (or bare `value`, key `None`) of a creep-law text.
@@ -393,7 +411,7 @@ impl FromStr for CreepLawSpec<f64> {
         let (keys, bare): (&[&str], Option<&str>) = match name {
             "kalker" => (&[], None),
             "mueller" | "mueller-kalker-saturated" => (&["exponent"], Some("exponent")),
-            "fastsim" => (&["nx", "ny"], Some("nx,ny")),
+            "fastsim" | "fastsim-sa" => (&["nx", "ny"], Some("nx,ny")),
             "fastsim-a" | "fastsim-a-integrated" => {
                 (&["strips", "sliding", "nodes"], Some("strips"))
             }
@@ -463,6 +481,10 @@ impl FromStr for CreepLawSpec<f64> {
                 }
             }
             "fastsim" => Self::Fastsim {
+                nx: count("nx", FASTSIM_DIVISIONS)?,
+                ny: count("ny", FASTSIM_DIVISIONS)?,
+            },
+            "fastsim-sa" => Self::FastsimSa {
                 nx: count("nx", FASTSIM_DIVISIONS)?,
                 ny: count("ny", FASTSIM_DIVISIONS)?,
             },
@@ -585,6 +607,14 @@ mod tests {
             parse("fastsim:ny=5"),
             CreepLawSpec::Fastsim { nx: 10, ny: 5 }
         );
+        assert_eq!(
+            parse("fastsim-sa:20"),
+            CreepLawSpec::FastsimSa { nx: 20, ny: 20 }
+        );
+        assert_eq!(
+            parse("fastsim-sa:ny=5"),
+            CreepLawSpec::FastsimSa { nx: 10, ny: 5 }
+        );
         assert_eq!(parse("fastsim-a"), CreepLawSpec::default());
         assert_eq!(
             parse("fastsim-a:12"),
@@ -633,6 +663,7 @@ mod tests {
             CreepLawSpec::MuellerKalkerSaturated { exponent: 2.0 },
             CreepLawSpec::fastsim(),
             CreepLawSpec::Fastsim { nx: 40, ny: 7 },
+            CreepLawSpec::FastsimSa { nx: 40, ny: 7 },
             CreepLawSpec::default(),
             CreepLawSpec::FastsimA {
                 strips: 3,
@@ -781,6 +812,10 @@ mod tests {
         assert_eq!(
             read("Fastsim(nx: 10, ny: 20)"),
             CreepLawSpec::Fastsim { nx: 10, ny: 20 }
+        );
+        assert_eq!(
+            read("FastsimSa(nx: 30, ny: 20)"),
+            CreepLawSpec::FastsimSa { nx: 30, ny: 20 }
         );
         assert_eq!(read("FastsimA(strips: 20)"), CreepLawSpec::default());
         assert_eq!(
