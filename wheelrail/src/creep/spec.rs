@@ -272,6 +272,33 @@ impl CreepLawSpec<f64> {
         }
     }
 
+    /// Every law with its default settings, once each (FastSim_A with both
+    /// its continuation and integrated sliding zones), FASTSIM first (the
+    /// reference of `umsim creep --compare`'s differences when it is given
+    /// no laws).
+    pub fn every_law() -> Vec<Self> {
+        vec![
+            Self::fastsim(),
+            Self::Kalker,
+            Self::mueller(),
+            Self::MuellerKalkerSaturated {
+                exponent: MUELLER_EXPONENT,
+            },
+            Self::FastsimSa {
+                nx: FASTSIM_DIVISIONS,
+                ny: FASTSIM_DIVISIONS,
+            },
+            Self::default(),
+            Self::FastsimA {
+                strips: FASTSIM_A_STRIPS,
+                sliding: SlidingZone::Integrated {
+                    nodes: INTEGRATED_NODES,
+                },
+            },
+            Self::polach(),
+        ]
+    }
+
     /// The law, after checking every setting (an error names the setting
     /// and its valid range). Polach's friction decrease is set up at speed 0;
     /// the caller passes the rolling speed to
@@ -730,6 +757,35 @@ mod tests {
             let e = text.parse::<CreepLawSpec>().unwrap_err().to_string();
             assert!(e.contains(expected), "{text}: {e}");
             assert!(e.starts_with(&format!("creep law \"{text}\"")), "{e}");
+        }
+    }
+
+    /// `every_law` names every law once (a new law must be added there).
+    #[test]
+    fn every_law_is_listed() {
+        let names: Vec<&str> = CreepLawSpec::every_law().iter().map(|s| s.name()).collect();
+        for spec in CreepLawSpec::every_law() {
+            // Exhaustive: a new variant fails to compile here until listed.
+            match spec {
+                CreepLawSpec::Kalker
+                | CreepLawSpec::Mueller { .. }
+                | CreepLawSpec::MuellerKalkerSaturated { .. }
+                | CreepLawSpec::Fastsim { .. }
+                | CreepLawSpec::FastsimSa { .. }
+                | CreepLawSpec::FastsimA { .. }
+                | CreepLawSpec::Polach { .. } => {}
+            }
+        }
+        for name in [
+            "kalker",
+            "mueller",
+            "mueller-kalker-saturated",
+            "fastsim",
+            "fastsim-sa",
+            "fastsim-a",
+            "polach",
+        ] {
+            assert!(names.contains(&name), "{name}");
         }
     }
 
