@@ -2,11 +2,14 @@
 //!
 //! ```text
 //! umsim creep --method LAW --cases FILE.csv [-o out.csv]
+//! umsim creep --compare [LAW …] --cases FILE.csv [-o out.csv]
 //! ```
 //!
 //! `LAW` is a creep law in the syntax of `umsim bench --creep` and of
-//! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]`,
-//! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
+//! [`CreepLawSpec`]'s `FromStr`: `kalker`, `mueller[:EXPONENT]` (Pogorelov
+//! 2005, Sect. 4.2), `mueller-kalker-saturated[:EXPONENT]`,
+//! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-sa[:N]` or
+//! `fastsim-sa:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
 //! `,sliding=continuation|integrated|picard` and `,nodes=K`,
 //! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`;
 //! defaults as in model files. FastSim_A's `integrated` sliding zones are more
@@ -19,9 +22,16 @@
 //! on the wheel in the contact frame, CONTACT's sign convention (`Fx < 0` for
 //! `ξ > 0`), one row per input row. A bad row is an error naming the row (data
 //! row number, 1-based, and file line) and the column.
+//!
+//! `--compare LAW LAW …` evaluates every case with each law (all laws with
+//! their defaults, [`CreepLawSpec::every_law`], if none is named) and writes
+//! one row per case: `row`, each law's `LAW.Fx,LAW.Fy,LAW.Mz`, then for every
+//! law after the first its differences from the first, `LAW.dFx,LAW.dFy,
+//! LAW.dMz` and `LAW.dF/muN` (= |(ΔFx, ΔFy)|/(μN)); a summary of the largest
+//! and mean `dF/muN` per law goes to standard error.
 
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepLaw, CreepLawSpec, Creepages, INTEGRATED_NODES, SlidingZone,
+    ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages, INTEGRATED_NODES, SlidingZone,
 };
 use std::io::{Read, Write};
 use std::path::PathBuf;
@@ -40,11 +50,13 @@ pub enum Sliding {
 /// The long help of a creep-law argument (`umsim creep --method`, `umsim bench
 /// --creep`): the syntax of [`CreepLawSpec`]'s `FromStr` and its defaults.
 pub(crate) const LAW_HELP: &str = concat!(
-    "Creep-force law and its settings: kalker | mueller[:EXPONENT] | ",
+    "Creep-force law and its settings: kalker | mueller[:EXPONENT] (Pogorelov 2005) | ",
+    "mueller-kalker-saturated[:EXPONENT] | ",
     "fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY | ",
+    "fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY (FastSim_SA: analytic adhesion, FASTSIM sliding) | ",
     "fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | ",
     "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]. ",
-    "Defaults: Mueller exponent 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
+    "Defaults: Mueller exponents 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
     "continuation sliding (8 Gauss nodes for integrated/picard), Polach ",
     "ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated"
 );
@@ -53,8 +65,20 @@ pub(crate) const LAW_HELP: &str = concat!(
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Creep-force law and its settings (`LAW[:key=value,…]`, see `--help`).
-    #[arg(long, visible_alias = "law", value_name = "LAW", long_help = LAW_HELP)]
-    pub method: CreepLawSpec,
+    #[arg(
+        long,
+        visible_alias = "law",
+        value_name = "LAW",
+        long_help = LAW_HELP,
+        required_unless_present = "compare",
+        conflicts_with = "compare"
+    )]
+    pub method: Option<CreepLawSpec>,
+    /// Compare laws on the same cases (each `LAW[:key=value,…]`; every law
+    /// with its defaults if none is given): their forces and differences
+    /// from the first.
+    #[arg(long, value_name = "LAW", num_args = 0..)]
+    pub compare: Option<Vec<CreepLawSpec>>,
     /// Number of strips (FASTSIM, FastSim_A): overrides the law's.
     #[arg(long)]
     pub strips: Option<usize>,
@@ -83,7 +107,7 @@ impl Args {
     /// `--sliding` and `--nodes` applied; an error for a flag the law has no
     /// setting for.
     pub fn spec(&self) -> Result<CreepLawSpec, String> {
-        let mut spec = self.method;
+        let mut spec = self.method.ok_or("--method LAW is needed (or --compare)")?;
         let not_for = |flag: &str, spec: &CreepLawSpec| {
             format!("--{flag} does not apply to the law {}", spec.name())
         };
@@ -132,14 +156,17 @@ impl Args {
     }
 }
 
-/// Evaluates every case of the CSV in `input` with `law` and writes `Fx,Fy,Mz`
-/// rows to `output`. `source` names the input in error messages.
-pub fn evaluate<R: Read, W: Write>(
-    law: &dyn CreepLaw,
-    input: R,
-    source: &str,
-    output: W,
-) -> Result<usize, String> {
+/// One case of a cases file: the patch, the creepages, and where it is (data
+/// row, 1-based, and file line) for messages.
+struct Case {
+    patch: ContactPatch,
+    creepages: Creepages,
+    row: usize,
+    line: u64,
+}
+
+/// Reads every case of the CSV in `input`; `source` names it in messages.
+fn read_cases<R: Read>(input: R, source: &str) -> Result<Vec<Case>, String> {
     let mut rd = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -158,10 +185,7 @@ pub fn evaluate<R: Read, W: Write>(
             )
         })?;
     }
-    let mut wr = csv::Writer::from_writer(output);
-    wr.write_record(["Fx", "Fy", "Mz"])
-        .map_err(|e| format!("cannot write output: {e}"))?;
-    let mut n = 0;
+    let mut cases = Vec::new();
     for (row, rec) in rd.records().enumerate() {
         let row = row + 1;
         let rec = rec.map_err(|e| format!("{source}: row {row}: {e}"))?;
@@ -176,61 +200,193 @@ pub fn evaluate<R: Read, W: Write>(
                 )
             })?;
         }
-        let patch = ContactPatch {
-            a: v[0],
-            b: v[1],
-            g: v[2],
-            nu: v[3],
-            mu: v[4],
-            n: v[5],
-        };
-        let c = Creepages {
-            xi: v[6],
-            eta: v[7],
-            phi: v[8],
-        };
-        let f = law
-            .forces(&patch, &c)
-            .map_err(|e| format!("{source}: row {row} (line {line}): {e}"))?;
-        if !(f.fx.is_finite() && f.fy.is_finite() && f.mz.is_finite()) {
-            return Err(format!(
-                "{source}: row {row} (line {line}): {} gives a non-finite result ({}, {}, {}) \
-                 for this case; nothing is written for it",
-                law.name(),
-                f.fx,
-                f.fy,
-                f.mz
-            ));
-        }
-        // `+ 0.0` turns −0 into 0 in the output.
-        wr.write_record([
-            (f.fx + 0.0).to_string(),
-            (f.fy + 0.0).to_string(),
-            (f.mz + 0.0).to_string(),
-        ])
-        .map_err(|e| format!("cannot write output: {e}"))?;
-        n += 1;
+        cases.push(Case {
+            patch: ContactPatch {
+                a: v[0],
+                b: v[1],
+                g: v[2],
+                nu: v[3],
+                mu: v[4],
+                n: v[5],
+            },
+            creepages: Creepages {
+                xi: v[6],
+                eta: v[7],
+                phi: v[8],
+            },
+            row,
+            line,
+        });
+    }
+    Ok(cases)
+}
+
+/// The forces of `law` for `case`: an error naming the case's row and line
+/// if the law refuses it or its result is not finite.
+fn case_forces(law: &dyn CreepLaw, case: &Case, source: &str) -> Result<CreepForces, String> {
+    let (row, line) = (case.row, case.line);
+    let f = law
+        .forces(&case.patch, &case.creepages)
+        .map_err(|e| format!("{source}: row {row} (line {line}): {e}"))?;
+    if !(f.fx.is_finite() && f.fy.is_finite() && f.mz.is_finite()) {
+        return Err(format!(
+            "{source}: row {row} (line {line}): {} gives a non-finite result ({}, {}, {}) \
+             for this case; nothing is written for it",
+            law.name(),
+            f.fx,
+            f.fy,
+            f.mz
+        ));
+    }
+    Ok(f)
+}
+
+/// `x` as written to the output CSV (`+ 0.0` turns −0 into 0).
+fn cell(x: f64) -> String {
+    (x + 0.0).to_string()
+}
+
+/// Evaluates every case of the CSV in `input` with `law` and writes `Fx,Fy,Mz`
+/// rows to `output`. `source` names the input in error messages.
+pub fn evaluate<R: Read, W: Write>(
+    law: &dyn CreepLaw,
+    input: R,
+    source: &str,
+    output: W,
+) -> Result<usize, String> {
+    let cases = read_cases(input, source)?;
+    let mut wr = csv::Writer::from_writer(output);
+    let werr = |e: csv::Error| format!("cannot write output: {e}");
+    wr.write_record(["Fx", "Fy", "Mz"]).map_err(werr)?;
+    for case in &cases {
+        let f = case_forces(law, case, source)?;
+        wr.write_record([cell(f.fx), cell(f.fy), cell(f.mz)])
+            .map_err(werr)?;
     }
     wr.flush()
         .map_err(|e| format!("cannot write output: {e}"))?;
-    Ok(n)
+    Ok(cases.len())
+}
+
+/// Largest and mean |ΔF|/(μN) of one law against the first, over the cases
+/// with μN > 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Difference {
+    /// The law, as written in the header.
+    pub law: String,
+    /// Largest |(ΔFx, ΔFy)|/(μN), –.
+    pub max: f64,
+    /// Mean |(ΔFx, ΔFy)|/(μN), –.
+    pub mean: f64,
+}
+
+/// `umsim creep --compare`: every case of `input` with each of `laws`
+/// (their text as given in `names`), written to `output` as described in the
+/// module documentation; returns each later law's difference from the first.
+pub fn compare<R: Read, W: Write>(
+    laws: &[(String, Box<dyn CreepLaw + Send + Sync>)],
+    input: R,
+    source: &str,
+    output: W,
+) -> Result<Vec<Difference>, String> {
+    let cases = read_cases(input, source)?;
+    let mut wr = csv::Writer::from_writer(output);
+    let werr = |e: csv::Error| format!("cannot write output: {e}");
+    let mut header = vec!["row".to_string()];
+    for (name, _) in laws {
+        for q in ["Fx", "Fy", "Mz"] {
+            header.push(format!("{name}.{q}"));
+        }
+    }
+    for (name, _) in laws.iter().skip(1) {
+        for q in ["dFx", "dFy", "dMz", "dF/muN"] {
+            header.push(format!("{name}.{q}"));
+        }
+    }
+    wr.write_record(&header).map_err(werr)?;
+    let mut sums = vec![(0.0_f64, 0.0_f64, 0usize); laws.len()];
+    for case in &cases {
+        let forces = laws
+            .iter()
+            .map(|(_, law)| case_forces(law.as_ref(), case, source))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut rec = vec![case.row.to_string()];
+        for f in &forces {
+            rec.extend([cell(f.fx), cell(f.fy), cell(f.mz)]);
+        }
+        let mu_n = case.patch.mu * case.patch.n;
+        let r = forces[0];
+        for (k, f) in forces.iter().enumerate().skip(1) {
+            let (dx, dy, dm) = (f.fx - r.fx, f.fy - r.fy, f.mz - r.mz);
+            let rel = if mu_n > 0.0 { dx.hypot(dy) / mu_n } else { 0.0 };
+            if mu_n > 0.0 {
+                let s = &mut sums[k];
+                s.0 = s.0.max(rel);
+                s.1 += rel;
+                s.2 += 1;
+            }
+            rec.extend([cell(dx), cell(dy), cell(dm), cell(rel)]);
+        }
+        wr.write_record(&rec).map_err(werr)?;
+    }
+    wr.flush()
+        .map_err(|e| format!("cannot write output: {e}"))?;
+    Ok(laws
+        .iter()
+        .zip(&sums)
+        .skip(1)
+        .map(|((name, _), &(max, sum, n))| Difference {
+            law: name.clone(),
+            max,
+            mean: if n > 0 { sum / n as f64 } else { 0.0 },
+        })
+        .collect())
 }
 
 /// Runs `umsim creep`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let law = args.spec()?.build()?;
     let source = args.cases.display().to_string();
     let file = std::fs::File::open(&args.cases).map_err(|e| format!("{source}: {e}"))?;
-    match &args.output {
-        Some(path) => {
-            let out = std::fs::File::create(path)
-                .map_err(|e| format!("{}: cannot create: {e}", path.display()))?;
-            evaluate(law.as_ref(), file, &source, std::io::BufWriter::new(out))?;
+    let out: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(std::io::BufWriter::new(
+            std::fs::File::create(path)
+                .map_err(|e| format!("{}: cannot create: {e}", path.display()))?,
+        )),
+        None => Box::new(std::io::stdout().lock()),
+    };
+    if let Some(compared) = &args.compare {
+        for flag in [
+            ("strips", args.strips.is_some()),
+            ("elements", args.elements.is_some()),
+            ("sliding", args.sliding.is_some()),
+            ("nodes", args.nodes.is_some()),
+        ] {
+            if flag.1 {
+                return Err(format!(
+                    "--{} does not apply to --compare (give each law its settings)",
+                    flag.0
+                )
+                .into());
+            }
         }
-        None => {
-            evaluate(law.as_ref(), file, &source, std::io::stdout().lock())?;
+        let specs = if compared.is_empty() {
+            CreepLawSpec::every_law()
+        } else {
+            compared.clone()
+        };
+        let laws = specs
+            .iter()
+            .map(|s| Ok((s.to_string(), s.build()?)))
+            .collect::<Result<Vec<_>, railmbs_wheelrail::creep::CreepError>>()?;
+        let diffs = compare(&laws, file, &source, out)?;
+        eprintln!("|ΔF|/(μN) against {}:", laws[0].0);
+        for d in diffs {
+            eprintln!("  {:<55} max {:.4}  mean {:.4}", d.law, d.max, d.mean);
         }
+        return Ok(());
     }
+    let law = args.spec()?.build()?;
+    evaluate(law.as_ref(), file, &source, out)?;
     Ok(())
 }
 
@@ -254,7 +410,14 @@ mod tests {
         let input = "xi,eta,phi,a,b,G,nu,mu,N\n\
                      0.001,0,0,0.006,0.004,8e10,0.28,0.3,80000\n\
                      0,0,0,0.006,0.004,8e10,0.28,0.3,80000\n";
-        for m in ["kalker", "mueller", "fastsim:10", "fastsim-a:10", "polach"] {
+        for m in [
+            "kalker",
+            "mueller",
+            "mueller-kalker-saturated",
+            "fastsim:10",
+            "fastsim-a:10",
+            "polach",
+        ] {
             let out = run_str(m, input).unwrap();
             let lines: Vec<&str> = out.lines().collect();
             assert_eq!(lines[0], "Fx,Fy,Mz");
@@ -400,8 +563,10 @@ mod tests {
             "kalker",
             "mueller",
             "mueller:3",
+            "mueller-kalker-saturated:2.5",
             "fastsim",
             "fastsim:20",
+            "fastsim-sa:nx=30,ny=12",
             "fastsim-a",
             "fastsim-a-integrated:12",
             "fastsim-a:sliding=picard",

@@ -297,10 +297,14 @@
 //!           mu: 0.4, young: 2.1e11, poisson: 0.28, normal_damping: 0,        // -, Pa, -, N s/m
 //!           creep: FastsimA(strips: 20, sliding: Continuation),   // default
 //!           // or FastsimA(strips: 20, sliding: Integrated(nodes: 8))   accurate at flange spin
-//!           // or Fastsim(nx: 10, ny: 10) | Kalker | Mueller(exponent: 2)
+//!           // or Fastsim(nx: 10, ny: 10) | Kalker
+//!           // or Mueller(exponent: 2)   Pogorelov 2005, Sect. 4.2 (load-dependent slope, sliding flange)
+//!           // or MuellerKalkerSaturated(exponent: 2)   Kalker's linear force saturated towards μN
 //!           // or Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))   (A, B s/m), optional
 //!           // (railmbs_wheelrail::creep::CreepLawSpec; its real settings may be expressions)
 //!           rail: Rigid,                      // or Elastic(ky: .., cy: .., kz: .., cz: ..)  N/m, N s/m
+//!           // Elastic(.., lateral_damping: Always)   cy in every contact mode (default), or
+//!           //     TwoPointContact: in two-point contact only (Pogorelov 2005, Sect. 4.2)
 //!           wheels: None,                     // independently rotating wheels: Some(("WheelL", "WheelR"))
 //!           table: (y_max: 0.025, dy: 1e-4, roll_max: 0.03, droll: 2e-3)),
 //! ```

@@ -11,10 +11,16 @@
 //! Laws:
 //! - [`KalkerLinear`]: Kalker's linear theory with the tabulated coefficients of
 //!   [`crate::kalker`];
-//! - [`Mueller`]: the linear force saturated towards `μN`;
+//! - [`Mueller`]: Mueller's method as Pogorelov 2005, Sect. 4.2 gives it
+//!   (empirical load-dependent slope, no spin, pure sliding at the flange
+//!   contact of a two-point contact);
+//! - [`MuellerKalkerSaturated`]: Kalker's linear force saturated towards `μN`
+//!   (this project's law, called `Mueller` until the paper's came);
 //! - [`Fastsim`]: Kalker's FASTSIM algorithm (simplified theory);
 //! - [`FastsimA`]: Pogorelov's semi-analytic FastSim_A (Pogorelov 2005, Sect. 4.3):
 //!   closed-form strips, cost proportional to the number of strips only;
+//! - [`FastsimSa`]: FastSim_SA (Pogorelov 2005, Sect. 4.3, Fig. 24): the
+//!   analytic adhesion zone, FASTSIM's elements in the sliding zone;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
 //!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
 //!
@@ -23,11 +29,19 @@
 
 mod fastsim;
 mod fastsim_a;
+mod fastsim_sa;
+mod kalker_linear;
+mod mueller;
+mod mueller_kalker_saturated;
 mod polach;
 mod spec;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
+pub use fastsim_sa::FastsimSa;
+pub use kalker_linear::KalkerLinear;
+pub use mueller::{MUELLER_MAX_LOAD, Mueller};
+pub use mueller_kalker_saturated::{MUELLER_EXPONENT, MuellerKalkerSaturated};
 pub use polach::Polach;
 pub use spec::{
     CREEP_LAW_SYNTAX, CreepLawSpec, FASTSIM_A_STRIPS, FASTSIM_DIVISIONS, ParseCreepLawError,
@@ -94,7 +108,7 @@ fn readable(x: f64) -> String {
 
 /// A creep-force law.
 pub trait CreepLaw {
-    /// Short name (`kalker`, `mueller`, `fastsim`, `fastsim-a`, `polach`).
+    /// Short name, as on the command line (`kalker`, `fastsim`, …).
     fn name(&self) -> &'static str;
     /// Forces on the wheel for the given patch and creepages; validates inputs.
     fn forces(&self, patch: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError>;
@@ -108,6 +122,60 @@ pub trait CreepLaw {
         _speed: f64,
     ) -> Result<CreepForces, CreepError> {
         self.forces(patch, c)
+    }
+    /// Forces of a contact in `mode` (one of a wheel's contacts in a one- or
+    /// two-point contact) at the rolling speed `speed` (m/s), for laws that
+    /// treat the flange contact of a two-point contact apart (the paper's
+    /// [`Mueller`]); the others give [`Self::forces_at_speed`].
+    fn forces_in_contact(
+        &self,
+        patch: &ContactPatch,
+        c: &Creepages,
+        speed: f64,
+        _mode: ContactMode,
+    ) -> Result<CreepForces, CreepError> {
+        self.forces_at_speed(patch, c, speed)
+    }
+}
+
+/// Smallest contact angle of a flange contact, rad (20°): see
+/// [`ContactMode::of_wheel`]. Tread contacts of S1002 on UIC60 stay below
+/// about 0.1 rad, the flange flank is near 70° (1.22 rad).
+pub const FLANGE_CONTACT_ANGLE: f64 = 0.349_065_850_398_865_9;
+
+/// The role of one of a wheel's contacts, for the laws that treat the
+/// flange contact of a two-point contact apart (Pogorelov 2005, Sect. 4.2,
+/// Mueller's method).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactMode {
+    /// The wheel's only loaded contact (on the tread or on the flange).
+    #[default]
+    Single,
+    /// The tread contact of a two-point contact.
+    TwoPointTread,
+    /// The flange contact of a two-point contact.
+    TwoPointFlange,
+}
+
+impl ContactMode {
+    /// The modes of a wheel's (up to two) contacts from their contact angles
+    /// `angles` (rad, either sign) and whether each carries load: with one
+    /// loaded contact it is [`Self::Single`]; with two, the contact of the
+    /// larger `|angle|` is the flange contact ([`Self::TwoPointFlange`]) if
+    /// that angle is at least [`FLANGE_CONTACT_ANGLE`], the other the tread
+    /// contact ([`Self::TwoPointTread`]); two loaded contacts both below the
+    /// threshold are both [`Self::TwoPointTread`]. An unloaded contact is
+    /// [`Self::Single`] (it has no force).
+    pub fn of_wheel(angles: [f64; 2], loaded: [bool; 2]) -> [Self; 2] {
+        if !(loaded[0] && loaded[1]) {
+            return [Self::Single; 2];
+        }
+        let flange = usize::from(angles[1].abs() > angles[0].abs());
+        let mut modes = [Self::TwoPointTread; 2];
+        if angles[flange].abs() >= FLANGE_CONTACT_ANGLE {
+            modes[flange] = Self::TwoPointFlange;
+        }
+        modes
     }
 }
 
@@ -190,110 +258,5 @@ impl Flexibilities {
             inv_l2: 0.375 * k.c22 * g_a,
             inv_l3: 4.0 / std::f64::consts::PI * k.c23 * g_a * (p.b * inv_a).sqrt(),
         }
-    }
-}
-
-/// Kalker's linear theory (no saturation), coefficients from [`crate::kalker`].
-/// Independent of `N` and `μ`, except that `N = 0` (no contact) gives zero force.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct KalkerLinear;
-
-impl KalkerLinear {
-    #[inline]
-    fn eval(p: &ContactPatch, c: &Creepages, k: &KalkerCoefficients) -> CreepForces {
-        let c2 = p.a * p.b;
-        let cc = c2.sqrt();
-        let gc2 = p.g * c2;
-        let gc3 = gc2 * cc;
-        let gc4 = gc2 * c2;
-        CreepForces {
-            fx: -gc2 * k.c11 * c.xi,
-            fy: -gc2 * k.c22 * c.eta - gc3 * k.c23 * c.phi,
-            mz: gc3 * k.c23 * c.eta - gc4 * k.c33 * c.phi,
-        }
-    }
-}
-
-impl CreepLaw for KalkerLinear {
-    fn name(&self) -> &'static str {
-        "kalker"
-    }
-    fn forces(&self, p: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError> {
-        let k = validate(p, c)?;
-        if p.n == 0.0 {
-            // No normal force, no contact: no tangential force.
-            return Ok(CreepForces::default());
-        }
-        Ok(Self::eval(p, c, &k))
-    }
-}
-
-/// Mueller-type saturation of Kalker's linear forces: with the linear tangential
-/// force `F_lin = |(Fx, Fy)|` and `u = F_lin/(μN)`, all of `Fx, Fy, Mz` are
-/// scaled by `1/(1 + uⁿ)^(1/n)`, so the force follows the linear theory at small
-/// creepage and tends to `μN` at large creepage. The exponent `n` (default
-/// [`MUELLER_EXPONENT`] = 2) sets the sharpness of the transition.
-///
-/// This is not the law Pogorelov 2005, Sect. 4.2 calls Mueller's method: that
-/// one saturates the same way (exponent `m`) but from an empirical,
-/// load-dependent slope `k_c(P) = P(235 + P(2.4 − 0.01P))`, `P = 0.001 N`,
-/// independent of the contact ellipse and of spin, with the flange contact as
-/// pure sliding. Here the slope is Kalker's linear theory, spin included.
-#[derive(Debug, Clone, Copy)]
-pub struct Mueller {
-    exponent: f64,
-}
-
-/// Default exponent `n` of [`Mueller`], –: used by model files, `umsim creep`
-/// and `umsim bench --creep` alike.
-pub const MUELLER_EXPONENT: f64 = 2.0;
-
-impl Default for Mueller {
-    fn default() -> Self {
-        Self {
-            exponent: MUELLER_EXPONENT,
-        }
-    }
-}
-
-impl Mueller {
-    /// Law with exponent `n` (> 0, finite).
-    pub fn new(exponent: f64) -> Result<Self, CreepError> {
-        if !(exponent.is_finite() && exponent > 0.0) {
-            return Err(CreepError::Parameter(format!(
-                "Mueller exponent must be positive and finite, got {exponent}"
-            )));
-        }
-        Ok(Self { exponent })
-    }
-}
-
-impl CreepLaw for Mueller {
-    fn name(&self) -> &'static str {
-        "mueller"
-    }
-    fn forces(&self, p: &ContactPatch, c: &Creepages) -> Result<CreepForces, CreepError> {
-        let k = validate(p, c)?;
-        let lin = KalkerLinear::eval(p, c, &k);
-        let limit = p.mu * p.n;
-        if limit <= 0.0 {
-            return Ok(CreepForces::default());
-        }
-        let u = (lin.fx * lin.fx + lin.fy * lin.fy).sqrt() / limit;
-        let s = if u == 0.0 {
-            1.0
-        } else if u > 1e8 {
-            // (1 + uⁿ)^(−1/n) = 1/u to within u⁻ⁿ/n relative; avoids overflow.
-            1.0 / u
-        } else if self.exponent == 3.0 {
-            1.0 / (1.0 + u * u * u).cbrt()
-        } else {
-            (1.0 + u.powf(self.exponent)).powf(-1.0 / self.exponent)
-        };
-        Ok(CreepForces {
-            fx: lin.fx * s,
-            fy: lin.fy * s,
-            mz: lin.mz * s,
-        })
     }
 }

@@ -11,6 +11,8 @@
 //! k_z d_z + c_z ḋ_z = −Σᵢ F_z,i        (vertical equilibrium)
 //! ```
 //!
+//! (the lateral damper `c_y` in every contact mode by default, or in
+//! two-point contact only, as in the paper: [`LateralDamping`]),
 //! where `Fᵢ = Nᵢ nᵢ + Tᵢ tᵢ` is the force of contact `i` on the wheel (normal
 //! force `Nᵢ` along the normal `nᵢ` from rail to wheel, lateral creep force `Tᵢ`
 //! along the in-plane tangent `tᵢ = (n_z, −n_y)`, i.e. `eᵧ` of the contact
@@ -59,7 +61,7 @@
 //! two-point contact), [`LinearizedContacts`] to first order from the contacts
 //! at zero displacement.
 
-use crate::creep::{ContactPatch, CreepForces, CreepLaw, Creepages};
+use crate::creep::{ContactMode, ContactPatch, CreepForces, CreepLaw, Creepages};
 use crate::geometry::{Contact, ContactGeometry};
 use crate::hertz::HertzShape;
 use crate::kalker::KalkerCoefficients;
@@ -114,6 +116,34 @@ pub struct RailSupport {
     pub kz: f64,
     /// Vertical damping, N·s/m (≥ 0).
     pub cz: f64,
+    /// When the lateral damping `cy` acts.
+    pub lateral_damping: LateralDamping,
+}
+
+/// When the rail's lateral damper acts.
+///
+/// The default is [`Self::Always`], not the paper's rule: without the
+/// lateral damper the creep force is the rail's only lateral damper (rate
+/// `f₂₂/V` through the rail's velocity in the creepage), and at low speed
+/// under a lateral load the outer iterations can fail to settle (the bundled
+/// test `elastic_rails_balance_a_lateral_axle_force`, a wheelset at
+/// standstill pushed against the rails with 20 kN, stops with "outer
+/// iterations did not converge"; falling back to the damped solution there
+/// makes the force switch between the two and the integrator's step
+/// collapse).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum LateralDamping {
+    /// In two-point contact only, as in Pogorelov 2005, Sect. 4.2 ("lateral
+    /// dissipation is taken into account for two-point contact mode only"):
+    /// the equilibrium is solved without the lateral damper, and again with
+    /// it if that equilibrium has two loaded contacts (so a wheel whose
+    /// flange just touches gets the damped solution even if the damper then
+    /// keeps the flange off).
+    TwoPointContact,
+    /// In every contact mode (the default).
+    #[default]
+    Always,
 }
 
 /// Geometry of one wheel–rail contact at a given rail displacement.
@@ -336,6 +366,8 @@ pub struct ElasticRailSolution {
     pub inner_iterations: usize,
     /// Outer iterations.
     pub outer_iterations: usize,
+    /// Whether the lateral damper `cy` acted (see [`LateralDamping`]).
+    pub lateral_damped: bool,
 }
 
 /// Solves the equilibrium of a massless elastic rail under one wheel, starting
@@ -360,7 +392,8 @@ pub fn solve(
 }
 
 /// [`solve`] with the outer iterations started from `start` (e.g. the
-/// previous step's creep forces: fewer outer iterations).
+/// previous step's creep forces: fewer outer iterations). The lateral damper
+/// acts as [`RailSupport::lateral_damping`] says.
 pub fn solve_from(
     support: &RailSupport,
     material: &ContactMaterial,
@@ -369,6 +402,40 @@ pub fn solve_from(
     d_prev: [f64; 2],
     start: &CreepStart,
     settings: &ElasticRailSettings,
+) -> Result<ElasticRailSolution, ElasticRailError> {
+    let solve = |damped| {
+        solve_damped(
+            support, material, geometry, law, d_prev, start, settings, damped,
+        )
+    };
+    match support.lateral_damping {
+        LateralDamping::Always => solve(true),
+        LateralDamping::TwoPointContact => {
+            let free = solve(false)?;
+            let loaded = free.contacts[..free.n_contacts]
+                .iter()
+                .filter(|c| c.normal_force > 0.0)
+                .count();
+            if support.cy > 0.0 && loaded == MAX_CONTACTS {
+                solve(true)
+            } else {
+                Ok(free)
+            }
+        }
+    }
+}
+
+/// [`solve_from`] with the lateral damper on (`damped`) or off.
+#[allow(clippy::too_many_arguments)]
+fn solve_damped(
+    support: &RailSupport,
+    material: &ContactMaterial,
+    geometry: &dyn RailContactGeometry,
+    law: &dyn CreepLaw,
+    d_prev: [f64; 2],
+    start: &CreepStart,
+    settings: &ElasticRailSettings,
+    damped: bool,
 ) -> Result<ElasticRailSolution, ElasticRailError> {
     let p = |s: String| Err(ElasticRailError::Parameter(s));
     if !(support.ky.is_finite() && support.ky > 0.0 && support.kz.is_finite() && support.kz > 0.0) {
@@ -401,8 +468,9 @@ pub fn solve_from(
     }
     // Effective stiffness with the damper over the step: K + C/h, and the
     // damper's memory term C/h·d_prev on the right-hand side.
+    let cy = if damped { support.cy } else { 0.0 };
     let (ch_y, ch_z) = if settings.h.is_finite() {
-        (support.cy / settings.h, support.cz / settings.h)
+        (cy / settings.h, support.cz / settings.h)
     } else {
         (0.0, 0.0)
     };
@@ -552,12 +620,25 @@ pub fn solve_from(
         let vel = rail_velocity(d, d_prev, settings.h);
         let mut change = 0.0_f64;
         let mut scale = 0.0_f64;
+        // One- or two-point contact, for the laws that treat the flange
+        // contact apart; the contact angle in the rail's cross-section.
+        let loaded = |i: usize| i < n_contacts && normal[i] > 0.0;
+        let angle = |i: usize| geo[i].normal[0].abs().atan2(geo[i].normal[1]);
+        let modes = ContactMode::of_wheel([angle(0), angle(1)], [loaded(0), loaded(1)]);
         for i in 0..n_contacts {
             let c = &geo[i];
             let [ny, nz] = c.normal;
             let t = [nz, -ny];
-            let (f, lateral_slope) =
-                creep_force(i, c, normal[i], material, law, vel, t, settings.v_roll)?;
+            let (f, lateral_slope) = creep_force(
+                i,
+                c,
+                (normal[i], modes[i]),
+                material,
+                law,
+                vel,
+                t,
+                settings.v_roll,
+            )?;
             change = change.max((f.fy - creep[i].fy).abs().max((f.fx - creep[i].fx).abs()));
             scale = scale.max(normal[i]);
             creep[i] = f;
@@ -606,6 +687,7 @@ pub fn solve_from(
                 wheel_force,
                 inner_iterations: inner_total,
                 outer_iterations: outer,
+                lateral_damped: damped,
             });
         }
     }
@@ -648,7 +730,7 @@ fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
     }
 }
 
-/// Creep forces of contact `i` for normal force `nn`; the rail's velocity
+/// Creep forces of contact `i` for normal force `nn` in `mode`; the rail's velocity
 /// `vel` moves the rail's material point, `Δη = −(vel·t)/V`. Also −∂T/∂η (N)
 /// of the lateral creep force: Kalker's f₂₂ = G a b C₂₂ scaled by the
 /// saturation |F|/|F_linear| (≤ 1) of the law's force; 0 without load or
@@ -657,7 +739,7 @@ fn rail_velocity(d: [f64; 2], d_prev: [f64; 2], h: f64) -> [f64; 2] {
 fn creep_force(
     i: usize,
     c: &RailContact,
-    nn: f64,
+    (nn, mode): (f64, ContactMode),
     material: &ContactMaterial,
     law: &dyn CreepLaw,
     vel: [f64; 2],
@@ -683,7 +765,7 @@ fn creep_force(
     // At the rolling speed, for laws whose friction falls with the slip
     // velocity (Polach).
     let f = law
-        .forces_at_speed(&patch, &cr, v_roll)
+        .forces_in_contact(&patch, &cr, v_roll, mode)
         .map_err(|e| contact_err(i, e))?;
     let lateral_slope = KalkerCoefficients::saturated_slopes(
         hc.a,
@@ -774,6 +856,7 @@ mod tests {
             cy: 1e5,
             kz: 100e6,
             cz: 2e5,
+            lateral_damping: LateralDamping::Always,
         };
         let material = ContactMaterial {
             g: 210e9 / (2.0 * 1.3),

@@ -10,7 +10,8 @@
 //! - [`conicity`]: equivalent conicity by EN 15302;
 //! - [`hertz`]: Hertzian contact ellipse, approach, pressure;
 //! - [`creepage`]: creepages and spin from body velocities;
-//! - [`creep`]: creep-force laws (Kalker linear, Mueller, FASTSIM, FastSim_A, Polach);
+//! - [`creep`]: creep-force laws (Kalker linear, Mueller (Pogorelov 2005), Kalker-saturated
+//!   Mueller, FASTSIM, FastSim_SA, FastSim_A, Polach);
 //! - [`kalker`]: Kalker's creepage coefficients;
 //! - [`elastic_rail`]: massless elastic rail with inner/outer iterations.
 

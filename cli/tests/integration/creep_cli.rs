@@ -60,7 +60,7 @@ fn every_method_reproduces_linear_theory_and_saturation() {
             vec!["--law", "fastsim-a:strips=20,sliding=integrated,nodes=8"],
             0.02,
         ),
-        (vec!["--method", "mueller:3"], 1e-6),
+        (vec!["--method", "mueller-kalker-saturated:3"], 1e-6),
         (
             vec![
                 "--method",
@@ -137,4 +137,86 @@ fn bad_law_is_named_and_help_gives_the_syntax() {
         help.contains("fastsim-a[:STRIPS]") && help.contains("polach[:ka="),
         "{help}"
     );
+}
+
+/// `umsim creep --compare`: each law's forces equal its own `--method` run
+/// (same text), the differences are those of the columns (to the last digit
+/// written: the differences are computed from the same f64 values), and
+/// without laws every registered law is compared against FASTSIM; the bundled
+/// sample cases file reads. On the saturated row 3 every law gives μN, so
+/// dF/muN < 1e-2 there (the Mueller laws reach μN to O(u⁻²)).
+#[test]
+fn compare_prints_each_law_and_the_differences() {
+    let laws = ["fastsim:20", "fastsim-sa:20", "mueller", "polach"];
+    let mut args = vec!["--compare"];
+    args.extend(laws);
+    let (ok, out, err) = run(&args, CASES);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("|ΔF|/(μN) against fastsim:nx=20,ny=20"),
+        "{err}"
+    );
+    let mut rd = csv::Reader::from_reader(out.as_bytes());
+    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header.len(), 1 + 3 * laws.len() + 4 * (laws.len() - 1));
+    let table: Vec<Vec<f64>> = rd
+        .records()
+        .map(|r| r.unwrap().iter().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(table.len(), 4);
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    for law in laws {
+        let (ok, single, err) = run(&["--method", law], CASES);
+        assert!(ok, "{err}");
+        let single = rows(&single);
+        let name = law
+            .parse::<railmbs_wheelrail::creep::CreepLawSpec>()
+            .unwrap()
+            .to_string();
+        for (r, s) in table.iter().zip(&single) {
+            assert_eq!(r[col(&format!("{name}.Fx"))], s[0], "{law}");
+            assert_eq!(r[col(&format!("{name}.Fy"))], s[1], "{law}");
+        }
+    }
+    for law in &laws[1..] {
+        let name = law
+            .parse::<railmbs_wheelrail::creep::CreepLawSpec>()
+            .unwrap()
+            .to_string();
+        for r in &table {
+            let d = r[col(&format!("{name}.Fx"))] - r[col("fastsim:nx=20,ny=20.Fx")];
+            assert_eq!(r[col(&format!("{name}.dFx"))], d, "{law}");
+        }
+        assert!(table[2][col(&format!("{name}.dF/muN"))] < 1e-2, "{law}");
+    }
+    let (ok, out, err) = run(&["--compare"], CASES);
+    assert!(ok, "{err}");
+    let first = out.lines().next().unwrap();
+    for law in [
+        "kalker",
+        "mueller:",
+        "mueller-kalker-saturated:",
+        "fastsim-sa:",
+        "fastsim-a:",
+        "polach:",
+    ] {
+        assert!(
+            first.contains(&format!(",{law}")) || first.contains(&format!(",\"{law}")),
+            "{law}: {first}"
+        );
+    }
+    assert!(
+        first.starts_with("row,\"fastsim:nx=10,ny=10.Fx\""),
+        "{first}"
+    );
+    // The sample cases file of the README.
+    let sample = std::fs::read_to_string(railmbs_testkit::model_path("creep/cases.csv")).unwrap();
+    let (ok, out, err) = run(&["--compare"], &sample);
+    assert!(ok, "{err}");
+    assert_eq!(out.lines().count(), 1 + 12);
 }

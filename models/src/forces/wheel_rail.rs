@@ -7,6 +7,7 @@ use crate::load::{Cx, Lookup, Where};
 use crate::model::BodyRef;
 use crate::raw::Value;
 use railmbs_wheelrail::creep::CreepLawSpec;
+use railmbs_wheelrail::elastic_rail::LateralDamping;
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfilePoints, ProfileSettings, read_points};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -132,6 +133,9 @@ pub enum RailKind {
         kz: Expr,
         /// Vertical damping, N s/m (default 0).
         cz: Expr,
+        /// When the lateral damping acts: `Always` (default) or
+        /// `TwoPointContact` (Pogorelov 2005, Sect. 4.2).
+        lateral_damping: LateralDamping,
     },
 }
 
@@ -258,6 +262,8 @@ pub(crate) enum RawRail {
         kz: Value,
         #[serde(default)]
         cz: Value,
+        #[serde(default)]
+        lateral_damping: LateralDamping,
     },
 }
 
@@ -381,12 +387,24 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
         .map(|key, v| cx.expr(w, &format!("creep.{key}"), key, v, false));
     let rail = match raw.rail {
         RawRail::Rigid => RailKind::Rigid,
-        RawRail::Elastic { ky, cy, kz, cz } => {
+        RawRail::Elastic {
+            ky,
+            cy,
+            kz,
+            cz,
+            lateral_damping,
+        } => {
             let ky = cx.expr(w, "rail.ky", "ky", ky, false);
             let cy = cx.expr(w, "rail.cy", "cy", cy, false);
             let kz = cx.expr(w, "rail.kz", "kz", kz, false);
             let cz = cx.expr(w, "rail.cz", "cz", cz, false);
-            RailKind::Elastic { ky, cy, kz, cz }
+            RailKind::Elastic {
+                ky,
+                cy,
+                kz,
+                cz,
+                lateral_damping: *lateral_damping,
+            }
         }
     };
     let t = raw.table;
@@ -491,7 +509,7 @@ impl ForceSpec for WheelRail {
         }
         creep.for_each_value_mut(|_, e| f(e));
         match rail {
-            RailKind::Elastic { ky, cy, kz, cz } => {
+            RailKind::Elastic { ky, cy, kz, cz, .. } => {
                 for e in [ky, cy, kz, cz] {
                     f(e);
                 }
@@ -522,7 +540,7 @@ impl ForceSpec for WheelRail {
         if let Err(e) = law.validate() {
             c.push("creep", e.to_string());
         }
-        if let RailKind::Elastic { ky, cy, kz, cz } = &self.rail {
+        if let RailKind::Elastic { ky, cy, kz, cz, .. } = &self.rail {
             c.positive("ky", ky);
             c.positive("kz", kz);
             c.non_negative("cy", cy);

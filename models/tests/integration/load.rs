@@ -371,3 +371,37 @@ fn wheel_rail_creep_law_settings_are_expressions() {
         assert!(e.contains(expected), "{law}: {e}");
     }
 }
+
+/// The elastic rail's lateral damping: in every contact mode unless the
+/// model says `lateral_damping: TwoPointContact` (Pogorelov 2005, Sect. 4.2).
+#[test]
+fn elastic_rail_lateral_damping_mode() {
+    use railmbs_wheelrail::elastic_rail::LateralDamping;
+    let mode = |rail: &str| {
+        let m = wheelset_with_creep(&format!("Kalker, rail: {rail}")).unwrap();
+        m.forces
+            .iter()
+            .find_map(|f| match &f.kind {
+                ForceKind::WheelRail(w) => match &w.rail {
+                    RailKind::Elastic {
+                        lateral_damping, ..
+                    } => Some(*lateral_damping),
+                    RailKind::Rigid => None,
+                },
+                _ => None,
+            })
+            .unwrap()
+    };
+    assert_eq!(
+        mode("Elastic(ky: 5e7, cy: 1e5, kz: 1e8)"),
+        LateralDamping::Always
+    );
+    assert_eq!(
+        mode("Elastic(ky: 5e7, cy: 1e5, kz: 1e8, lateral_damping: TwoPointContact)"),
+        LateralDamping::TwoPointContact
+    );
+    assert!(
+        wheelset_with_creep("Kalker, rail: Elastic(ky: 5e7, kz: 1e8, lateral_damping: Never)")
+            .is_err()
+    );
+}

@@ -373,24 +373,25 @@ fn sqrt_integrals(a2: f64, u1: f64, u2: f64) -> Antiderivs {
     }
 }
 
-/// Per-evaluation constants of the strips.
-struct StripConsts {
-    a: f64,
-    b: f64,
-    kk: f64,
-    bb: f64,
-    cc: f64,
-    alpha: f64,
-    bc: f64,
+/// Per-evaluation constants of the strips: semi-axes `a`, `b` (m), the
+/// bound's `K`, `B = η/L2`, `C = φ/(2L3)`, `α = K² − C²`, `BC`.
+pub(super) struct StripConsts {
+    pub(super) a: f64,
+    pub(super) b: f64,
+    pub(super) kk: f64,
+    pub(super) bb: f64,
+    pub(super) cc: f64,
+    pub(super) alpha: f64,
+    pub(super) bc: f64,
     /// ξ/L1 and φ/L3.
-    wx: f64,
-    wphi: f64,
+    pub(super) wx: f64,
+    pub(super) wphi: f64,
 }
 
 /// `t* = aⱼ + x*` of a strip's adhesion boundary (0 ≤ t* ≤ 2aⱼ; the sliding
 /// zone is `0 ≤ t ≤ t*`), for `A` = `a_` and half-length `aj_`.
 #[inline(always)]
-fn adhesion_boundary(a_: f64, aj_: f64, k: &StripConsts) -> f64 {
+pub(super) fn adhesion_boundary(a_: f64, aj_: f64, k: &StripConsts) -> f64 {
     let StripConsts { bb, alpha, bc, .. } = *k;
     let len = 2.0 * aj_;
     let w0 = a_ * a_ + bb * bb;
@@ -412,6 +413,33 @@ fn adhesion_boundary(a_: f64, aj_: f64, k: &StripConsts) -> f64 {
         root
     };
     t.max(0.0).min(len)
+}
+
+/// Force and moment of a strip's adhesion zone `x* ≤ x ≤ aⱼ` (traction on
+/// the rail, times 1/Δy), `p = (aⱼ − x)(A, B + C(aⱼ + x))` (Pogorelov 2005,
+/// Eq. 20) integrated exactly; `a_` = A, `aj_` = aⱼ, `y_` the strip's `y`,
+/// `tstar` = aⱼ + x*.
+#[inline(always)]
+pub(super) fn adhesion_zone(
+    a_: f64,
+    aj_: f64,
+    y_: f64,
+    tstar: f64,
+    bb: f64,
+    cc: f64,
+) -> (f64, f64, f64) {
+    let xs = tstar - aj_;
+    let sl = 2.0 * aj_ - tstar;
+    let a2 = aj_ * aj_;
+    let cub = sl * (a2 + aj_ * xs + xs * xs) * (1.0 / 3.0); // (aⱼ³ − x*³)/3
+    let i0 = 0.5 * sl * sl; // ∫(aⱼ − x)
+    let i_par = sl * a2 - cub; // ∫(aⱼ² − x²)
+    let ix_lin = aj_ * sl * tstar * 0.5 - cub; // ∫x(aⱼ − x)
+    let ix_par = a2 * sl * tstar * 0.5 - sl * tstar * (a2 + xs * xs) * 0.25; // ∫x(aⱼ² − x²)
+    let afx = a_ * i0;
+    let afy = bb * i0 + cc * i_par;
+    let amz = bb * ix_lin + cc * ix_par - y_ * afx;
+    (afx, afy, amz)
 }
 
 /// Sliding-zone corrections (traction on the rail, times 1/Δy) of up to
@@ -635,21 +663,11 @@ fn chunk_sums<const LANES: usize>(chunk: &[(f64, f64)], k: &StripConsts) -> (f64
     // Pass 2: zone integrals.
     for l in 0..LANES {
         let (a_, aj_, y_) = (aa[l], aj[l], y[l]);
-        let len = 2.0 * aj_;
         let tstar = ts[l];
         let xs = tstar - aj_;
-        let sl = len - tstar;
         xs_l[l] = xs;
-        // Adhesion zone x* ≤ x ≤ aⱼ: p = (aⱼ − x)(A, B + C(aⱼ + x)).
         let a2 = aj_ * aj_;
-        let cub = sl * (a2 + aj_ * xs + xs * xs) * (1.0 / 3.0); // (aⱼ³ − x*³)/3
-        let i0 = 0.5 * sl * sl; // ∫(aⱼ − x)
-        let i_par = sl * a2 - cub; // ∫(aⱼ² − x²)
-        let ix_lin = aj_ * sl * tstar * 0.5 - cub; // ∫x(aⱼ − x)
-        let ix_par = a2 * sl * tstar * 0.5 - sl * tstar * (a2 + xs * xs) * 0.25; // ∫x(aⱼ² − x²)
-        let afx = a_ * i0;
-        let afy = bb * i0 + cc * i_par;
-        let amz = bb * ix_lin + cc * ix_par - y_ * afx;
+        let (afx, afy, amz) = adhesion_zone(a_, aj_, y_, tstar, bb, cc);
         // Sliding zone −aⱼ ≤ x ≤ x*: direction d = (A, B' + C x) with
         // B' = B + C aⱼ (the adhesion solution continued).
         let ell = tstar;

@@ -17,8 +17,8 @@ use std::fmt::{self, Display};
 use std::str::FromStr;
 
 use super::{
-    CreepError, CreepLaw, Fastsim, FastsimA, INTEGRATED_NODES, KalkerLinear, MUELLER_EXPONENT,
-    Mueller, Polach, SlidingZone,
+    CreepError, CreepLaw, Fastsim, FastsimA, FastsimSa, INTEGRATED_NODES, KalkerLinear,
+    MUELLER_EXPONENT, Mueller, MuellerKalkerSaturated, Polach, SlidingZone,
 };
 
 /// Default number of strips of FastSim_A when a command line leaves it out
@@ -42,8 +42,10 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// | text | law |
 /// |---|---|
 /// | `kalker` | [`KalkerLinear`] |
-/// | `mueller`, `mueller:3`, `mueller:exponent=3` | [`Mueller`], exponent default [`MUELLER_EXPONENT`] |
+/// | `mueller`, `mueller:3`, `mueller:exponent=3` | [`Mueller`] (Pogorelov 2005, Sect. 4.2), exponent default [`MUELLER_EXPONENT`] |
+/// | `mueller-kalker-saturated[:EXPONENT]` | [`MuellerKalkerSaturated`], exponent default [`MUELLER_EXPONENT`] |
 /// | `fastsim`, `fastsim:20` (20 × 20), `fastsim:nx=20,ny=10` | [`Fastsim`], `nx` elements per strip, `ny` strips, default [`FASTSIM_DIVISIONS`] each |
+/// | `fastsim-sa`, `fastsim-sa:20` (20 × 20), `fastsim-sa:nx=20,ny=10` | [`FastsimSa`], `nx` FASTSIM elements per strip (in the sliding zone), `ny` strips, default [`FASTSIM_DIVISIONS`] each |
 /// | `fastsim-a`, `fastsim-a:20`, `fastsim-a:strips=20,sliding=integrated,nodes=8` | [`FastsimA`], default [`FASTSIM_A_STRIPS`] strips, sliding `continuation` (default), `integrated` or `picard` with `nodes` Gauss nodes (default [`INTEGRATED_NODES`]) |
 /// | `fastsim-a-integrated[:STRIPS]` | `fastsim-a:strips=STRIPS,sliding=integrated` |
 /// | `polach`, `polach:ka=0.5,ks=0.3,friction_decrease=0.4/0.6` | [`Polach`], `ka`, `ks` default 1, `friction_decrease` = `A/B` (B in s/m) optional |
@@ -55,13 +57,14 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// # Model-file syntax (RON, feature `serde`)
 ///
 /// ```text
-/// Kalker | Mueller(exponent: 2) | Fastsim(nx: 10, ny: 10)
+/// Kalker | Mueller(exponent: 2) | MuellerKalkerSaturated(exponent: 2)
+/// Fastsim(nx: 10, ny: 10) | FastsimSa(nx: 10, ny: 10)
 /// FastsimA(strips: 20, sliding: Continuation)      // or Integrated(nodes: 8), Picard(nodes: 8)
 /// Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))
 /// ```
 ///
-/// `Mueller`'s exponent, `FastsimA`'s sliding and all of `Polach`'s settings
-/// may be left out (their defaults as above); `Fastsim`'s `nx`, `ny` and
+/// The Mueller laws' exponent, `FastsimA`'s sliding and all of `Polach`'s settings
+/// may be left out (their defaults as above); `Fastsim`'s and `FastsimSa`'s `nx`, `ny` and
 /// `FastsimA`'s `strips` must be given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -78,8 +81,18 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 pub enum CreepLawSpec<N = f64> {
     /// Kalker's linear theory, no saturation ([`KalkerLinear`]).
     Kalker,
-    /// Kalker's linear forces saturated towards `μN` ([`Mueller`]).
+    /// Mueller's method as Pogorelov 2005, Sect. 4.2 gives it ([`Mueller`]):
+    /// empirical load-dependent slope, pure sliding at the flange contact of
+    /// a two-point contact.
     Mueller {
+        /// Exponent `m` of the saturation, – (> 0; default [`MUELLER_EXPONENT`]).
+        #[cfg_attr(feature = "serde", serde(default = "serde_impl::mueller_exponent"))]
+        exponent: N,
+    },
+    /// Kalker's linear forces saturated towards `μN`
+    /// ([`MuellerKalkerSaturated`]; this project's `Mueller` before the
+    /// paper's law came).
+    MuellerKalkerSaturated {
         /// Exponent `n` of the saturation, – (> 0; default [`MUELLER_EXPONENT`]).
         #[cfg_attr(feature = "serde", serde(default = "serde_impl::mueller_exponent"))]
         exponent: N,
@@ -87,6 +100,15 @@ pub enum CreepLawSpec<N = f64> {
     /// Kalker's FASTSIM ([`Fastsim`]) in its strip layout, parabolic bound.
     Fastsim {
         /// Elements per strip, in the rolling direction (≥ 1).
+        nx: usize,
+        /// Strips across the ellipse (≥ 1).
+        ny: usize,
+    },
+    /// FastSim_SA ([`FastsimSa`]): analytic adhesion zone, FASTSIM's
+    /// elements in the sliding zone.
+    FastsimSa {
+        /// FASTSIM elements per strip, in the rolling direction (≥ 1); the
+        /// sliding zone gets elements no longer than `2a_y/nx`.
         nx: usize,
         /// Strips across the ellipse (≥ 1).
         ny: usize,
@@ -138,12 +160,14 @@ impl<N> Default for CreepLawSpec<N> {
 
 impl<N> CreepLawSpec<N> {
     /// The law's short name, as on the command line (`kalker`, `mueller`,
-    /// `fastsim`, `fastsim-a`, `polach`).
+    /// `mueller-kalker-saturated`, `fastsim`, `fastsim-a`, `polach`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::Kalker => "kalker",
             Self::Mueller { .. } => "mueller",
+            Self::MuellerKalkerSaturated { .. } => "mueller-kalker-saturated",
             Self::Fastsim { .. } => "fastsim",
+            Self::FastsimSa { .. } => "fastsim-sa",
             Self::FastsimA { .. } => "fastsim-a",
             Self::Polach { .. } => "polach",
         }
@@ -170,7 +194,11 @@ impl<N> CreepLawSpec<N> {
             Self::Mueller { exponent } => CreepLawSpec::Mueller {
                 exponent: f("exponent", exponent)?,
             },
+            Self::MuellerKalkerSaturated { exponent } => CreepLawSpec::MuellerKalkerSaturated {
+                exponent: f("exponent", exponent)?,
+            },
             Self::Fastsim { nx, ny } => CreepLawSpec::Fastsim { nx: *nx, ny: *ny },
+            Self::FastsimSa { nx, ny } => CreepLawSpec::FastsimSa { nx: *nx, ny: *ny },
             Self::FastsimA { strips, sliding } => CreepLawSpec::FastsimA {
                 strips: *strips,
                 sliding: *sliding,
@@ -196,8 +224,13 @@ impl<N> CreepLawSpec<N> {
     /// mutably: to rewrite expressions in place.
     pub fn for_each_value_mut(&mut self, mut f: impl FnMut(&'static str, &mut N)) {
         match self {
-            Self::Kalker | Self::Fastsim { .. } | Self::FastsimA { .. } => {}
-            Self::Mueller { exponent } => f("exponent", exponent),
+            Self::Kalker
+            | Self::Fastsim { .. }
+            | Self::FastsimSa { .. }
+            | Self::FastsimA { .. } => {}
+            Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
+                f("exponent", exponent)
+            }
             Self::Polach {
                 ka,
                 ks,
@@ -239,6 +272,33 @@ impl CreepLawSpec<f64> {
         }
     }
 
+    /// Every law with its default settings, once each (FastSim_A with both
+    /// its continuation and integrated sliding zones), FASTSIM first (the
+    /// reference of `umsim creep --compare`'s differences when it is given
+    /// no laws).
+    pub fn every_law() -> Vec<Self> {
+        vec![
+            Self::fastsim(),
+            Self::Kalker,
+            Self::mueller(),
+            Self::MuellerKalkerSaturated {
+                exponent: MUELLER_EXPONENT,
+            },
+            Self::FastsimSa {
+                nx: FASTSIM_DIVISIONS,
+                ny: FASTSIM_DIVISIONS,
+            },
+            Self::default(),
+            Self::FastsimA {
+                strips: FASTSIM_A_STRIPS,
+                sliding: SlidingZone::Integrated {
+                    nodes: INTEGRATED_NODES,
+                },
+            },
+            Self::polach(),
+        ]
+    }
+
     /// The law, after checking every setting (an error names the setting
     /// and its valid range). Polach's friction decrease is set up at speed 0;
     /// the caller passes the rolling speed to
@@ -247,7 +307,11 @@ impl CreepLawSpec<f64> {
         Ok(match *self {
             Self::Kalker => Box::new(KalkerLinear),
             Self::Mueller { exponent } => Box::new(Mueller::new(exponent)?),
+            Self::MuellerKalkerSaturated { exponent } => {
+                Box::new(MuellerKalkerSaturated::new(exponent)?)
+            }
             Self::Fastsim { nx, ny } => Box::new(Fastsim::new(ny, nx)?),
+            Self::FastsimSa { nx, ny } => Box::new(FastsimSa::new(ny, nx)?),
             Self::FastsimA { strips, sliding } => {
                 Box::new(FastsimA::new(strips)?.with_sliding(sliding)?)
             }
@@ -279,8 +343,12 @@ impl<N: Display> Display for CreepLawSpec<N> {
         f.write_str(self.name())?;
         match self {
             Self::Kalker => Ok(()),
-            Self::Mueller { exponent } => write!(f, ":exponent={exponent}"),
-            Self::Fastsim { nx, ny } => write!(f, ":nx={nx},ny={ny}"),
+            Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
+                write!(f, ":exponent={exponent}")
+            }
+            Self::Fastsim { nx, ny } | Self::FastsimSa { nx, ny } => {
+                write!(f, ":nx={nx},ny={ny}")
+            }
             Self::FastsimA { strips, sliding } => {
                 write!(f, ":strips={strips},sliding=")?;
                 match sliding {
@@ -316,8 +384,9 @@ pub struct ParseCreepLawError {
 }
 
 /// The syntax, for error messages and command-line help.
-pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | fastsim[:N] | \
-     fastsim:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
+pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | \
+     mueller-kalker-saturated[:EXPONENT] | fastsim[:N] | \
+     fastsim:nx=NX,ny=NY | fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
      fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]";
 
 /// One `key=value` (or bare `value`, key `None`) of a creep-law text.
@@ -368,8 +437,8 @@ impl FromStr for CreepLawSpec<f64> {
         // (key, the key a bare value stands for): the keys each law accepts.
         let (keys, bare): (&[&str], Option<&str>) = match name {
             "kalker" => (&[], None),
-            "mueller" => (&["exponent"], Some("exponent")),
-            "fastsim" => (&["nx", "ny"], Some("nx,ny")),
+            "mueller" | "mueller-kalker-saturated" => (&["exponent"], Some("exponent")),
+            "fastsim" | "fastsim-sa" => (&["nx", "ny"], Some("nx,ny")),
             "fastsim-a" | "fastsim-a-integrated" => {
                 (&["strips", "sliding", "nodes"], Some("strips"))
             }
@@ -427,13 +496,22 @@ impl FromStr for CreepLawSpec<f64> {
         };
         let spec = match name {
             "kalker" => Self::Kalker,
-            "mueller" => Self::Mueller {
-                exponent: match get("exponent") {
+            "mueller" | "mueller-kalker-saturated" => {
+                let exponent = match get("exponent") {
                     Some(v) => real("exponent", v)?,
                     None => MUELLER_EXPONENT,
-                },
-            },
+                };
+                if name == "mueller" {
+                    Self::Mueller { exponent }
+                } else {
+                    Self::MuellerKalkerSaturated { exponent }
+                }
+            }
             "fastsim" => Self::Fastsim {
+                nx: count("nx", FASTSIM_DIVISIONS)?,
+                ny: count("ny", FASTSIM_DIVISIONS)?,
+            },
+            "fastsim-sa" => Self::FastsimSa {
                 nx: count("nx", FASTSIM_DIVISIONS)?,
                 ny: count("ny", FASTSIM_DIVISIONS)?,
             },
@@ -543,6 +621,10 @@ mod tests {
         assert_eq!(parse("kalker"), CreepLawSpec::Kalker);
         assert_eq!(parse("mueller"), CreepLawSpec::mueller());
         assert_eq!(parse("mueller:3"), CreepLawSpec::Mueller { exponent: 3.0 });
+        assert_eq!(
+            parse("mueller-kalker-saturated:exponent=3"),
+            CreepLawSpec::MuellerKalkerSaturated { exponent: 3.0 }
+        );
         assert_eq!(parse("fastsim"), CreepLawSpec::fastsim());
         assert_eq!(
             parse("fastsim:20"),
@@ -551,6 +633,14 @@ mod tests {
         assert_eq!(
             parse("fastsim:ny=5"),
             CreepLawSpec::Fastsim { nx: 10, ny: 5 }
+        );
+        assert_eq!(
+            parse("fastsim-sa:20"),
+            CreepLawSpec::FastsimSa { nx: 20, ny: 20 }
+        );
+        assert_eq!(
+            parse("fastsim-sa:ny=5"),
+            CreepLawSpec::FastsimSa { nx: 10, ny: 5 }
         );
         assert_eq!(parse("fastsim-a"), CreepLawSpec::default());
         assert_eq!(
@@ -597,8 +687,10 @@ mod tests {
             CreepLawSpec::Kalker,
             CreepLawSpec::mueller(),
             CreepLawSpec::Mueller { exponent: 2.5 },
+            CreepLawSpec::MuellerKalkerSaturated { exponent: 2.0 },
             CreepLawSpec::fastsim(),
             CreepLawSpec::Fastsim { nx: 40, ny: 7 },
+            CreepLawSpec::FastsimSa { nx: 40, ny: 7 },
             CreepLawSpec::default(),
             CreepLawSpec::FastsimA {
                 strips: 3,
@@ -665,6 +757,35 @@ mod tests {
             let e = text.parse::<CreepLawSpec>().unwrap_err().to_string();
             assert!(e.contains(expected), "{text}: {e}");
             assert!(e.starts_with(&format!("creep law \"{text}\"")), "{e}");
+        }
+    }
+
+    /// `every_law` names every law once (a new law must be added there).
+    #[test]
+    fn every_law_is_listed() {
+        let names: Vec<&str> = CreepLawSpec::every_law().iter().map(|s| s.name()).collect();
+        for spec in CreepLawSpec::every_law() {
+            // Exhaustive: a new variant fails to compile here until listed.
+            match spec {
+                CreepLawSpec::Kalker
+                | CreepLawSpec::Mueller { .. }
+                | CreepLawSpec::MuellerKalkerSaturated { .. }
+                | CreepLawSpec::Fastsim { .. }
+                | CreepLawSpec::FastsimSa { .. }
+                | CreepLawSpec::FastsimA { .. }
+                | CreepLawSpec::Polach { .. } => {}
+            }
+        }
+        for name in [
+            "kalker",
+            "mueller",
+            "mueller-kalker-saturated",
+            "fastsim",
+            "fastsim-sa",
+            "fastsim-a",
+            "polach",
+        ] {
+            assert!(names.contains(&name), "{name}");
         }
     }
 
@@ -741,8 +862,16 @@ mod tests {
             CreepLawSpec::Mueller { exponent: 3.0 }
         );
         assert_eq!(
+            read("MuellerKalkerSaturated()"),
+            parse("mueller-kalker-saturated")
+        );
+        assert_eq!(
             read("Fastsim(nx: 10, ny: 20)"),
             CreepLawSpec::Fastsim { nx: 10, ny: 20 }
+        );
+        assert_eq!(
+            read("FastsimSa(nx: 30, ny: 20)"),
+            CreepLawSpec::FastsimSa { nx: 30, ny: 20 }
         );
         assert_eq!(read("FastsimA(strips: 20)"), CreepLawSpec::default());
         assert_eq!(

@@ -8,7 +8,7 @@ use crate::common;
 use common::*;
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, Fastsim, FastsimA, FastsimLayout,
-    KalkerLinear, Mueller, Polach, SlidingZone, TractionBound,
+    KalkerLinear, Mueller, MuellerKalkerSaturated, Polach, SlidingZone, TractionBound,
 };
 
 /// At small creepage FASTSIM and FastSim_A reproduce Kalker's linear theory: the
@@ -71,8 +71,8 @@ fn linear_limit_matches_kalker() {
 }
 
 /// At large creepage the whole contact slides and the force is μN (Coulomb);
-/// FASTSIM and FastSim_A normalise the bound so this holds to rounding, Mueller
-/// approaches it as 1 − O(u⁻³).
+/// FASTSIM and FastSim_A normalise the bound so this holds to rounding, the
+/// Mueller laws approach it as 1 − O(u⁻²).
 #[test]
 fn large_creepage_saturates_at_mu_n() {
     let p = tread_patch();
@@ -86,6 +86,7 @@ fn large_creepage_saturates_at_mu_n() {
         ),
         Box::new(FastsimA::new(10).unwrap()),
         Box::new(FastsimA::integrated(10).unwrap()),
+        Box::new(MuellerKalkerSaturated::default()),
         Box::new(Mueller::default()),
     ];
     for law in &laws {
@@ -375,11 +376,12 @@ fn fastsim_a_integrated_other_ellipses() {
     );
 }
 
-/// Mueller: linear at small creepage, μN at large, monotone in between.
+/// Kalker-saturated Mueller: linear at small creepage, μN at large, monotone
+/// in between.
 #[test]
-fn mueller_saturation() {
+fn mueller_kalker_saturated_saturation() {
     let p = tread_patch();
-    let m = Mueller::default();
+    let m = MuellerKalkerSaturated::default();
     let c = Creepages {
         xi: 1e-7,
         eta: 0.0,
@@ -403,7 +405,7 @@ fn mueller_saturation() {
         assert!(-f.fx > last && -f.fx < p.mu * p.n);
         last = -f.fx;
     }
-    assert!(Mueller::new(0.0).is_err());
+    assert!(MuellerKalkerSaturated::new(0.0).is_err());
 }
 
 /// Bad input is an error naming the input, never a panic or NaN.
@@ -418,6 +420,7 @@ fn bad_input_is_named() {
     let laws: Vec<Box<dyn CreepLaw>> = vec![
         Box::new(KalkerLinear),
         Box::new(Mueller::default()),
+        Box::new(MuellerKalkerSaturated::default()),
         Box::new(Fastsim::new(5, 5).unwrap()),
         Box::new(FastsimA::new(5).unwrap()),
         Box::new(FastsimA::integrated(5).unwrap()),
@@ -505,6 +508,7 @@ fn extreme_inputs_stay_finite_and_bounded() {
     let laws: Vec<Box<dyn CreepLaw>> = vec![
         Box::new(KalkerLinear),
         Box::new(Mueller::default()),
+        Box::new(MuellerKalkerSaturated::default()),
         Box::new(Fastsim::new(7, 9).unwrap()),
         Box::new(
             Fastsim::new(7, 9)

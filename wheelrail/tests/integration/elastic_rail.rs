@@ -3,7 +3,8 @@
 
 use railmbs_wheelrail::creep::{Creepages, FastsimA};
 use railmbs_wheelrail::elastic_rail::{
-    ContactMaterial, ElasticRailSettings, LinearizedContacts, RailContact, RailSupport, solve,
+    ContactMaterial, ElasticRailSettings, LateralDamping, LinearizedContacts, RailContact,
+    RailSupport, solve,
 };
 use railmbs_wheelrail::hertz::{HertzShape, wheel_rail_curvatures};
 
@@ -35,6 +36,7 @@ fn static_load_springs_in_series() {
         cy: 0.0,
         kz: 100e6,
         cz: 0.0,
+        lateral_damping: LateralDamping::Always,
     };
     let geo = LinearizedContacts {
         contacts: vec![RailContact {
@@ -79,6 +81,7 @@ fn lateral_equilibrium_balances() {
         cy: 0.0,
         kz: 120e6,
         cz: 0.0,
+        lateral_damping: LateralDamping::Always,
     };
     let gamma: f64 = 0.2; // contact angle, rad; normal tilted towards −y
     let normal = [-gamma.sin(), gamma.cos()];
@@ -130,6 +133,7 @@ fn two_point_contact() {
         cy: 0.0,
         kz: 100e6,
         cz: 0.0,
+        lateral_damping: LateralDamping::Always,
     };
     let flange_angle: f64 = 1.1; // ~63°
     let (ca, cb) = wheel_rail_curvatures(0.47, -1.0 / 0.015, 1.0 / 0.013);
@@ -193,6 +197,7 @@ fn damping_and_errors() {
         cy: 0.0,
         kz: 100e6,
         cz: 1e5,
+        lateral_damping: LateralDamping::Always,
     };
     let geo = LinearizedContacts {
         contacts: vec![RailContact {
@@ -299,6 +304,7 @@ fn profile_geometry_static_load() {
         cy: 0.0,
         kz: 100e6,
         cz: 0.0,
+        lateral_damping: LateralDamping::Always,
     };
     let law = FastsimA::new(10).unwrap();
     let sol = solve(
@@ -319,4 +325,94 @@ fn profile_geometry_static_load() {
     assert!(load > 10e3 && load < 200e3, "{load}");
     assert!((support.kz * sol.displacement[1] + sol.wheel_force[1]).abs() < 1e-8 * load);
     assert!((support.ky * sol.displacement[0] + sol.wheel_force[0]).abs() < 1e-8 * load + 1e-3);
+}
+
+/// Lateral rail damping in two-point contact only (Pogorelov 2005, Sect.
+/// 4.2) against `Always` (the default): over a 1 ms step from rest, a
+/// one-point tread contact with lateral creep sees no lateral damper (the
+/// lateral equilibrium is `k_y d_y + F_y = 0` with the step's creep
+/// forces), while the same wheel in two-point contact (tread and flange) is
+/// solved with it (`k_y d_y + c_y d_y/h + F_y = 0`) exactly as with
+/// `Always`. Tolerances: the equilibria to 1e-8 of the load (the solver's
+/// force tolerance is 1e-6 N on loads of 1e5 N).
+#[test]
+fn lateral_damping_in_two_point_contact_only() {
+    let (ca, cb) = wheel_rail_curvatures(0.47, -1.0 / 0.015, 1.0 / 0.013);
+    let flange_angle: f64 = 1.1;
+    let tread = RailContact {
+        approach: 0.8e-3,
+        normal: [-0.025_f64.sin(), 0.025_f64.cos()],
+        hertz: tread_shape(),
+        creepages: Creepages {
+            xi: 1e-3,
+            eta: -2e-3,
+            phi: 0.1,
+        },
+    };
+    let flange = RailContact {
+        approach: 1.0e-3,
+        normal: [-flange_angle.sin(), flange_angle.cos()],
+        hertz: HertzShape::new(ca, cb, 210e9, 0.3).unwrap(),
+        creepages: Creepages {
+            xi: -2e-3,
+            eta: -1e-3,
+            phi: -1.5,
+        },
+    };
+    let paper = RailSupport {
+        ky: 30e6,
+        cy: 2e5,
+        kz: 100e6,
+        cz: 0.0,
+        lateral_damping: LateralDamping::TwoPointContact,
+    };
+    let always = RailSupport {
+        lateral_damping: LateralDamping::default(),
+        ..paper
+    };
+    assert_eq!(always.lateral_damping, LateralDamping::Always);
+    let h = 1e-3;
+    let settings = ElasticRailSettings {
+        h,
+        v_roll: 30.0,
+        ..Default::default()
+    };
+    let law = FastsimA::new(10).unwrap();
+    let run = |support: &RailSupport, contacts: Vec<RailContact>| {
+        solve(
+            support,
+            &steel(),
+            &LinearizedContacts { contacts },
+            &law,
+            [0.0; 2],
+            &settings,
+        )
+        .unwrap()
+    };
+    let lateral_residual = |s: &railmbs_wheelrail::elastic_rail::ElasticRailSolution, cy: f64| {
+        paper.ky * s.displacement[0] + cy * s.displacement[0] / h + s.wheel_force[0]
+    };
+    // One-point: undamped under the paper's rule, damped under Always.
+    let one = run(&paper, vec![tread]);
+    let one_always = run(&always, vec![tread]);
+    let load = one.contacts[0].normal_force;
+    assert!(!one.lateral_damped && one_always.lateral_damped);
+    assert!(lateral_residual(&one, 0.0).abs() < 1e-8 * load);
+    assert!(lateral_residual(&one_always, paper.cy).abs() < 1e-8 * load);
+    // The damper holds the rail back over the step: a smaller lateral
+    // displacement (the creep force, through the rail's velocity in the
+    // creepage, damps it too, so not by c_y/h against k_y alone).
+    eprintln!(
+        "one-point lateral rail displacement: {:.4e} m undamped, {:.4e} m damped",
+        one.displacement[0], one_always.displacement[0]
+    );
+    assert!(one_always.displacement[0].abs() < 0.99 * one.displacement[0].abs());
+    // Two-point: damped either way, the same solution.
+    let two = run(&paper, vec![tread, flange]);
+    let two_always = run(&always, vec![tread, flange]);
+    assert!(two.lateral_damped);
+    assert!(two.contacts[0].normal_force > 0.0 && two.contacts[1].normal_force > 0.0);
+    assert_eq!(two.displacement, two_always.displacement);
+    let load = two.contacts[0].normal_force + two.contacts[1].normal_force;
+    assert!(lateral_residual(&two, paper.cy).abs() < 1e-8 * load);
 }

@@ -80,13 +80,6 @@ impl WheelRailContact {
             nu: self.c.poisson,
             mu: self.c.mu,
         };
-        // The support's effective stiffness over the step, K + C/h (the
-        // backward-Euler damper).
-        let keff = if h.is_finite() {
-            [support.ky + support.cy / h, support.kz + support.cz / h]
-        } else {
-            [support.ky, support.kz]
-        };
         let settings = ElasticRailSettings {
             h,
             v_roll: s.speed,
@@ -111,6 +104,14 @@ impl WheelRailContact {
         )
         .map_err(|e| self.diverged(t, format!("{side_name} rail: {e}")))?;
         let d = sol.displacement;
+        // The support's effective stiffness over the step, K + C/h (the
+        // backward-Euler damper; the lateral one where it acted).
+        let cy = if sol.lateral_damped { support.cy } else { 0.0 };
+        let keff = if h.is_finite() {
+            [support.ky + cy / h, support.kz + support.cz / h]
+        } else {
+            [support.ky, support.kz]
+        };
         state.rail_d[s.side] = d;
         state.rail_creep[s.side] = CreepStart {
             forces: sol.contacts.map(|c| c.creep),

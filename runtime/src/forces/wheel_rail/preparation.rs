@@ -246,11 +246,18 @@ impl WheelRailContact {
                 .try_map(|key, e| eval_scalar(e, params, &name, key))?,
             rail: match &s.rail {
                 RailKind::Rigid => None,
-                RailKind::Elastic { ky, cy, kz, cz } => Some(RailSupport {
+                RailKind::Elastic {
+                    ky,
+                    cy,
+                    kz,
+                    cz,
+                    lateral_damping,
+                } => Some(RailSupport {
                     ky: ev(ky, "rail.ky")?,
                     cy: ev(cy, "rail.cy")?,
                     kz: ev(kz, "rail.kz")?,
                     cz: ev(cz, "rail.cz")?,
+                    lateral_damping: *lateral_damping,
                 }),
             },
         };

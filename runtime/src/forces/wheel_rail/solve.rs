@@ -8,7 +8,7 @@ use super::kinematics::ContactKinematics;
 use crate::forces::{ForceContext, ForceJacobian};
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_wheelrail::creep::{ContactPatch, CreepForces, Creepages};
+use railmbs_wheelrail::creep::{ContactMode, ContactPatch, CreepForces, Creepages};
 use railmbs_wheelrail::elastic_rail::CreepStart;
 use railmbs_wheelrail::geometry::Contact;
 use railmbs_wheelrail::kalker::KalkerCoefficients;
@@ -132,7 +132,11 @@ impl WheelRailContact {
                 };
                 let sets: [&[Contact; 2]; 2] = [&left[0], &right[1]];
                 for (side, geo) in sides.iter().enumerate() {
-                    for c in sets[side] {
+                    // Normal forces of both contacts first: whether the wheel
+                    // is in two-point contact decides the flange contact's
+                    // creep law (ContactMode).
+                    let mut loaded: [Option<(ContactKinematics, f64, f64)>; 2] = [None, None];
+                    for (slot, c) in loaded.iter_mut().zip(sets[side]) {
                         let Some(k) = self.kinematics(geo, c, [0.0; 2])? else {
                             continue;
                         };
@@ -144,6 +148,18 @@ impl WheelRailContact {
                         if normal == 0.0 {
                             continue;
                         }
+                        *slot = Some((k, elastic, normal));
+                    }
+                    let angle = |i: usize| loaded[i].as_ref().map_or(0.0, |(k, ..)| k.angle);
+                    let modes = ContactMode::of_wheel(
+                        [angle(0), angle(1)],
+                        [loaded[0].is_some(), loaded[1].is_some()],
+                    );
+                    for (slot, mode) in loaded.iter().zip(modes) {
+                        let Some((k, elastic, normal)) = slot else {
+                            continue;
+                        };
+                        let (elastic, normal) = (*elastic, *normal);
                         let stiffness = if elastic > 0.0 {
                             k.shape.stiffness(k.approach)
                         } else {
@@ -156,11 +172,11 @@ impl WheelRailContact {
                         let patch = self.patch(hertz.a, hertz.b, normal);
                         let forces = b
                             .law
-                            .forces_at_speed(&patch, &k.creepages, k.speed)
+                            .forces_in_contact(&patch, &k.creepages, k.speed, mode)
                             .map_err(|e| self.diverged(t, format!("creep forces: {e}")))?;
                         let damper_power = (normal - elastic) * k.approach_rate;
                         let st = self.contact_state(
-                            &k,
+                            k,
                             &patch,
                             (normal, stiffness),
                             forces,
