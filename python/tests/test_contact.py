@@ -137,8 +137,10 @@ def kalker_coefficients(a_over_b: float, nu: str):
     [
         # Kalker's linear law interpolates the table: at a tabulated node, exact to rounding.
         ("kalker", 1e-9),
-        # Mueller: F_lin / (1 + (F_lin/μN)^n)^(1/n), off by (F_lin/μN)^n ≈ 1e-10 here.
-        ("mueller", 1e-6),
+        # Kalker-saturated Mueller: F_lin / (1 + (F_lin/μN)^n)^(1/n), off by
+        # (F_lin/μN)^n ≈ 1e-10 here. (The paper's Mueller law has its own,
+        # load-dependent slope: see the next test.)
+        ("mueller-kalker-saturated", 1e-6),
         # FASTSIM and FastSim_A: flexibilities defined from C11, C22, C23; what
         # remains is the strip quadrature (0.5 % for 10 strips): 2 %, as the Rust test.
         ("fastsim", 0.02),
@@ -165,6 +167,21 @@ def test_creep_at_small_creepage_is_kalker_linear(law, tol):
     assert abs(fx[0] / ref_fx - 1) < tol
     assert abs(fy[1] / ref_fy - 1) < tol
     assert abs(fy[2] / ref_spin - 1) < tol
+
+
+def test_paper_mueller_law_has_the_papers_load_dependent_slope():
+    # Pogorelov 2005, Sect. 4.2: k_c(P) = P (235 + P (2.4 - 0.01 P)) kN per
+    # unit creepage, P the normal load in kN; at small creepage F = k_c ρ,
+    # independent of the patch and of spin.
+    a = b = 5e-3
+    for N in (50e3, 80e3, 120e3):
+        P = N / 1000.0
+        k_c = 1000.0 * P * (235.0 + P * (2.4 - 0.01 * P))  # N per unit creepage
+        eps = 1e-7
+        fx, fy, mz = contact.creep_forces("mueller", a, b, N, [eps, 0.0], [0.0, eps], [0.0, 0.0], friction=0.3)
+        assert abs(fx[0] / (-k_c * eps) - 1) < 1e-6
+        assert abs(fy[1] / (-k_c * eps) - 1) < 1e-6
+        assert mz[0] == 0.0
 
 
 @pytest.mark.parametrize("law", ["kalker-less", "fastsim:0", "mueller:x"])
