@@ -14,7 +14,7 @@ use std::process::Command;
 /// Median process CPU time (s) of `umsim run SCENARIO --engine ENGINE` with
 /// its CSV written to a temporary file, after one run that fills the caches
 /// (the plugin and contact tables are built once per model, not per run);
-/// repeated as [`super::timing::median_run`] repeats runs.
+/// repeated up to three times within [`RUN_SECONDS`] in all.
 pub fn process_cpu(scenario: &Path, engine: Engine) -> Result<f64, String> {
     let exe = std::env::current_exe().map_err(|e| format!("umsim's own path: {e}"))?;
     let dir = tempfile::tempdir().map_err(|e| format!("temporary folder: {e}"))?;
