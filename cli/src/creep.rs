@@ -92,10 +92,10 @@ pub struct Args {
     /// overrides the law's.
     #[arg(long)]
     pub nodes: Option<usize>,
-    /// Input CSV with columns a,b,G,nu,mu,N,xi,eta,phi.
+    /// Input CSV with columns a,b (contact semi-axes, m), G (combined shear modulus, Pa), nu (Poisson ratio, -), mu (friction coefficient, -), N (normal force, N), xi,eta (longitudinal and lateral creepage, -), phi (spin creepage, 1/m); see models/creep/cases.csv.
     #[arg(long)]
     pub cases: PathBuf,
-    /// Output CSV (Fx,Fy,Mz); standard output if omitted.
+    /// Output CSV (Fx,Fy in N, Mz in N·m; forces on the wheel); standard output if omitted.
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
 }

@@ -41,10 +41,10 @@ pub struct Args {
     /// Column of the horizontal axis, e.g. `s[m]` for the distance along the track.
     #[arg(long = "x", value_name = "COLUMN", default_value = "time")]
     pub x: String,
-    /// Plot only rows with x ≥ this value.
+    /// Plot only rows with x ≥ this value (in the x column's unit: s for time, m for `s[m]`).
     #[arg(long, value_name = "X", allow_negative_numbers = true)]
     pub from: Option<f64>,
-    /// Plot only rows with x ≤ this value.
+    /// Plot only rows with x ≤ this value (in the x column's unit).
     #[arg(long, value_name = "X", allow_negative_numbers = true)]
     pub to: Option<f64>,
     /// Title above the panels.
