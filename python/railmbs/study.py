@@ -18,8 +18,10 @@ table::
 The table (``OUTPUT/results.csv``, the same file ``umsim study`` writes and
 resumes) has one row per case: ``index``, ``case_id``, the variables,
 ``status`` (``ok``/``failed``), ``error``, ``steps``, ``rejected_steps``,
-``t_end[s]``, ``integration_time[s]``, ``cpu_time[s]``, ``wall_time[s]``,
-then the reductions. Each row is appended (and flushed) as its case
+``t_end[s]`` (simulated time reached), ``integration_time[s]`` (CPU time of
+the integration), ``cpu_time[s]`` (CPU time of the case: set-up, run,
+reductions), ``wall_time[s]`` (wall-clock time of the case), then the
+reductions (SI units, named in the column headers). Each row is appended (and flushed) as its case
 finishes, so nothing finished is lost when the study is interrupted or a
 worker dies; running :func:`run` again skips the finished case ids. A case
 that fails (diverges, a bad parameter value) is a row with its error; it does

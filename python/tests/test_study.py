@@ -286,3 +286,23 @@ def test_ctrl_c_stops_the_local_pool_and_the_study_resumes(tmp_path):
     df = rs.run(path, tmp_path / "out", progress=False, on_result=lambda r: rest.append(r["case_id"]))
     assert sorted(before + rest) == sorted(c["id"] for c in rs.load(path).cases())
     assert list(df["status"]) == ["ok"] * 4
+
+
+def test_a_worker_without_the_clients_plugin_file_builds_it_through_its_cache(study_dir, tmp_path):
+    # Another machine without the shared cache: the shipped path does not
+    # exist there, so the worker's engine is prepared through the cache
+    # (once per process) instead of failing.
+    path = write_tiny(study_dir)
+    _, shipped = rs.engine(path)
+    _, eng = rs.engine(path, [tmp_path / "elsewhere" / "plugin.so"])
+    b = eng.builds()
+    assert b["derived"] + b["indexed"] == 1 and b["loaded"] == 1
+    assert eng.plugin_paths == shipped.plugin_paths
+    # The worker's engine is cached: the same object on the next task.
+    assert rs.engine(path, [tmp_path / "elsewhere" / "plugin.so"])[1] is eng
+    # Another study of the same model loads the same plugin file; a wrong
+    # number of plugin files is refused.
+    other = rs.load(write_slow(tmp_path))
+    assert rs.StudyEngine.from_plugins(other, shipped.plugin_paths).builds()["loaded"] == 1
+    with pytest.raises(railmbs.PluginError, match="plugin file"):
+        rs.StudyEngine.from_plugins(other, [])
