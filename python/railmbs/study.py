@@ -205,8 +205,11 @@ def run(
     ``$RAILMBS_CACHE_DIR``, else the platform cache folder).
     ``on_result(row)``: called with each recorded row (column → cell text);
     an exception it raises stops the study (running local cases stop
-    unrecorded, pending Dask tasks are cancelled) and propagates, as does
-    Ctrl-C; the rows recorded stay, and the next :func:`run` resumes.
+    unrecorded; Dask tasks not yet finished are cancelled, and a case
+    already running on a worker ends there unrecorded) and propagates, as
+    does Ctrl-C; the rows recorded stay, and the next :func:`run` resumes.
+    A Dask worker that dies (killed, out of memory) loses only its running
+    case, which the scheduler gives to another worker.
 
     Raises :class:`railmbs.ModelError` for a bad study file,
     :class:`railmbs.PluginError` when the plugin cannot be built,
