@@ -10,17 +10,25 @@ Run a scenario in process, with the numbers ``umsim run`` writes::
     r["time"], r.columns, r.summary, r.to_pandas()
 
 The wheel–rail contact functions over numpy arrays are in
-:mod:`railmbs.contact`. Errors derive from :class:`railmbs.RailmbsError`
-(:mod:`railmbs.errors`).
+:mod:`railmbs.contact`; parameter studies (the study files of ``umsim
+study``, on a local pool or a Dask cluster) in :mod:`railmbs.study`.
+Errors derive from :class:`railmbs.RailmbsError` (:mod:`railmbs.errors`).
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Tuple, Union
 
-from . import contact, errors
+from . import contact, errors, study
 from ._railmbs import CREEP_LAW_SYNTAX, Model, Scenario
-from .errors import ContactError, ModelError, PluginError, RailmbsError, SimulationError
+from .errors import (
+    ContactError,
+    ModelError,
+    PluginError,
+    RailmbsError,
+    SimulationError,
+    StudyError,
+)
 from .result import RunResult
 
 __all__ = [
@@ -33,9 +41,11 @@ __all__ = [
     "RunResult",
     "Scenario",
     "SimulationError",
+    "StudyError",
     "contact",
     "errors",
     "run",
+    "study",
 ]
 
 

@@ -5,7 +5,7 @@ Units are SI throughout; see the docstrings (``help(railmbs.Scenario)``).
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Set, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -106,6 +106,92 @@ class Scenario:
         end; an exception it raises, or Ctrl-C, stops the run and is re-raised.
         Raises ``ModelError``, ``PluginError``, ``SimulationError`` (with the
         partial ``result``)."""
+
+_Row = List[str]
+
+class Study:
+    """A study file (``Study(...)``, RON, as ``umsim study`` reads it; the
+    format is documented in the ``railmbs-study`` crate)."""
+
+    @staticmethod
+    def load(path: _Path) -> Study:
+        """Reads and checks a study file, its scenario and model(s). Raises
+        ``railmbs.ModelError`` (file, element, line, column)."""
+    @staticmethod
+    def from_string(text: str, path: _Path = "study.ron") -> Study:
+        """Reads study text; ``path`` names it in errors and resolves the
+        scenario relative to its folder."""
+    @property
+    def path(self) -> Path: ...
+    @property
+    def engine(self) -> str:
+        """``"symbolic"`` (one compiled plugin for all cases) or ``"numeric"``."""
+    @property
+    def models(self) -> List[str]:
+        """Model names, in the order of ``StudyEngine.plugin_paths``."""
+    @property
+    def variables(self) -> List[str]: ...
+    @property
+    def time_series(self) -> bool:
+        """Whether each case's output is written as ``series/<case id>.csv``."""
+    def cases(self) -> List[Dict[str, Any]]:
+        """The cases in index order: dicts with ``index`` (int), ``id`` (16
+        hex digits, stable across machines and runs) and ``inputs``
+        (variable → float, or the text of an expression or macro name)."""
+    def result_header(self) -> List[str]:
+        """Columns of the result table: ``index``, ``case_id``, the variables,
+        ``status``, ``error``, ``steps``, ``rejected_steps``, ``t_end[s]``,
+        ``integration_time[s]``, ``cpu_time[s]``, ``wall_time[s]``, the
+        reductions."""
+    def __len__(self) -> int: ...
+
+class StudyEngine:
+    """A study's model plugin, built and loaded once per process, that runs
+    its cases (the GIL released)."""
+
+    @staticmethod
+    def prepare(study: Study, cache_dir: Optional[_Path] = None) -> StudyEngine:
+        """Derives and builds the plugin through the content-hash cache
+        (``cache_dir``, else ``$RAILMBS_CACHE_DIR``, else the platform cache)
+        unless cached, and loads it. Raises ``railmbs.PluginError``."""
+    @staticmethod
+    def from_plugins(study: Study, paths: List[_Path]) -> StudyEngine:
+        """Loads plugins built elsewhere (one per model of ``study.models``,
+        each checked against its model); compiles nothing."""
+    @property
+    def plugin_paths(self) -> List[Path]:
+        """The loaded plugin files (empty for a numeric study)."""
+    def builds(self) -> Dict[str, int]:
+        """Counters ``derived``, ``indexed``, ``compiled``, ``loaded``."""
+    def run_case(self, case: Union[int, str], series_dir: Optional[_Path] = None) -> _Row:
+        """Runs one case (index or id) to its row: the table's cells as text
+        (times in s). A failed run is a row with status ``failed`` and its
+        error. The GIL is released; Ctrl-C raises KeyboardInterrupt. Raises
+        ``railmbs.StudyError`` for a reduction that fits no output column."""
+    def run_local(
+        self, store: ResultStore, jobs: int = 0, on_result: Optional[Callable[[_Row], Any]] = None
+    ) -> Dict[str, Any]:
+        """Runs the cases ``store`` lacks on ``jobs`` threads (0: one per
+        core), appending each row as it finishes and then calling
+        ``on_result(row)``; an exception it raises, or Ctrl-C, stops the
+        study and is re-raised. Returns ``skipped``, ``recorded``,
+        ``failed``, ``interrupted``."""
+
+class ResultStore:
+    """The append-only, resumable result table (``results.csv``)."""
+
+    @staticmethod
+    def open(path: _Path, header: List[str]) -> ResultStore:
+        """Opens or creates the table; drops a partly written last line.
+        Raises ``railmbs.StudyError`` for a table of other columns."""
+    @property
+    def path(self) -> Path: ...
+    def finished(self) -> Set[str]:
+        """Ids of the cases in the table."""
+    @property
+    def dropped_partial_line(self) -> bool: ...
+    def append(self, row: _Row) -> None:
+        """Appends a row (as ``StudyEngine.run_case`` returns it) and flushes it."""
 
 class Profile:
     """A smoothed wheel or rail profile (use ``railmbs.contact.Profile``)."""

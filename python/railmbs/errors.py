@@ -67,3 +67,11 @@ class PluginError(RailmbsError, RuntimeError):
 
 class ContactError(RailmbsError, ValueError):
     """Bad input to a contact function (profile file, geometry, creep case)."""
+
+
+class StudyError(RailmbsError, RuntimeError):
+    """A study cannot go on: its result table is unusable (written by another
+    study, or the study file changed since), a file cannot be written, or a
+    reduction fits no output column of the run (a fault of the study file,
+    the same for every case). A case that fails is not an error: it is a row
+    of the table with status ``failed`` and its message."""

@@ -91,7 +91,9 @@ pub struct CaseResult {
     pub rejected_steps: usize,
     /// Simulated time reached, s.
     pub t_end: f64,
-    /// Wall-clock time of the integration (the runner's), s.
+    /// Time of the integration by the runner's clock (the CPU time of the
+    /// case's thread; wall-clock time where the platform has no thread
+    /// clock), s.
     pub integration_time: f64,
     /// CPU time of the case's thread (set-up, run, reductions), s.
     pub cpu_time: f64,

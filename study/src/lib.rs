@@ -148,9 +148,10 @@
 //!
 //! `results.csv`, one row per case: `index`, `case_id`, the variables,
 //! `status` (`ok` or `failed`), `error`, `steps`, `rejected_steps`,
-//! `t_end[s]` (time reached), `integration_time[s]` (wall-clock time of the
-//! integration), `cpu_time[s]` (CPU time of the case's thread: set-up, run,
-//! reductions), `wall_time[s]` (wall-clock time of the case), then the
+//! `t_end[s]` (time reached), `integration_time[s]` (the integration's
+//! time by the runner's clock: CPU time of the case's thread, wall-clock
+//! time where the platform has no thread clock), `cpu_time[s]` (CPU time of
+//! the case's thread: set-up, run, reductions), `wall_time[s]` (wall-clock time of the case), then the
 //! reductions. A failed case has empty reductions
 //! (values of a run cut short are not written as if fine) and its error.
 
