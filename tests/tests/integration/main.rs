@@ -12,3 +12,4 @@ mod train;
 mod vehicle2;
 mod wheelset_variants;
 mod wheelsets;
+mod wickens;

@@ -21,8 +21,7 @@ fn scenario(file: &str, set: &[(&str, &str)]) -> (Scenario, Model) {
 }
 
 fn modes_of(s: &Scenario, model: &Model, engine: Box<dyn Equations>) -> SpeedModes {
-    scenario_modes(s, model, engine, &ContactTableCache::new())
-        .unwrap_or_else(|e| panic!("{e}"))
+    scenario_modes(s, model, engine, &ContactTableCache::new()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn param(model: &Model, s: &Scenario, name: &str) -> f64 {
