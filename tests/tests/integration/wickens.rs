@@ -1,8 +1,9 @@
 //! The hunting mode of the full model against the classical analytic linear
 //! models of a single wheelset: Wickens' wheelset on lateral and yaw springs
 //! (Wickens 1965; as Knothe & Stichel, "Rail Vehicle Dynamics", Springer
-//! 2017, Sect. 8.1, and Garg & Dukkipati, "Dynamics of Railway Vehicle
-//! Systems", Academic Press 1984, Ch. 5, write it) and the free wheelset's
+//! 2017, and Garg & Dukkipati, "Dynamics of Railway Vehicle Systems",
+//! Academic Press 1984, write it in their chapters on the wheelset's
+//! lateral dynamics) and the free wheelset's
 //! kinematic oscillation (Klingel 1883), both through `umsim modes`' path
 //! ([`scenario_modes`]).
 //!
@@ -56,8 +57,7 @@ struct WheelsetContact {
 
 impl WheelsetContact {
     /// f11 = G a b C11, f22 = G a b C22 (N), f23 = G (ab)^{3/2} C23 (N m),
-    /// f33 = G (ab)² C33 (N m²): Kalker's linear theory (Kalker 1967; the
-    /// forms of Knothe & Stichel 2017, Sect. 6.4).
+    /// f33 = G (ab)² C33 (N m²): Kalker's linear theory (Kalker 1967).
     fn coefficients(&self) -> (f64, f64, f64, f64) {
         let c2 = self.a * self.b;
         let gc2 = self.g * c2;
@@ -142,8 +142,8 @@ struct Suspension {
 }
 
 /// The state matrix of the linear wheelset at speed `v` (m/s), state
-/// (y, ψ, ẏ, ψ̇). Wickens' equations (Knothe & Stichel 2017, Eqs. 8.1–8.2;
-/// Garg & Dukkipati 1984, Eqs. 5.28) with the per-wheel creep coefficients
+/// (y, ψ, ẏ, ψ̇). Wickens' equations (in the form of
+/// Knothe & Stichel 2017 and Garg & Dukkipati 1984) with the per-wheel creep coefficients
 /// f11, f22 and the spin terms f23, f33 of Kalker's linear theory:
 ///
 /// ```text
@@ -158,8 +158,8 @@ struct Suspension {
 /// forces' lateral components give the gravitational stiffness
 /// kg = Q d(tan δ_L − tan δ_R)/dy; the equilibrium spin's lateral forces
 /// ±f23 sin δ/r0 change with the contact angles and oppose it:
-/// ks = f23 cos δ0 d(δ_L − δ_R)/dy / r0 (Knothe & Stichel 2017,
-/// Sect. 8.1: "the spin creep force reduces the gravitational stiffness").
+/// ks = f23 cos δ0 d(δ_L − δ_R)/dy / r0 (the reduction of the gravitational stiffness
+/// by spin creep that Wickens pointed out).
 /// The spin moment's change with the contact angles, f33 cos δ0 dΔδ/dy / r0,
 /// is kept in the yaw row.
 ///
@@ -342,7 +342,7 @@ fn wheelset_on_springs_hunts_as_wickens_linear_wheelset() {
 }
 
 /// The free wheelset's kinematic oscillation: Klingel's frequency
-/// f = V/(2π) √(λ/(r0 e)) (Klingel 1883; Knothe & Stichel 2017, Sect. 8.1)
+/// f = V/(2π) √(λ/(r0 e)) (Klingel 1883)
 /// is the limit of the hunting mode's frequency as V → 0, where the creep
 /// forces (∝ f22, f11, independent of V) dominate inertia (∝ V²) and the
 /// net gravitational stiffness. λ, r0, e from the profiles as above.
