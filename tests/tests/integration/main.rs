@@ -1,6 +1,7 @@
 //! The integration tests of `tests`, one module per topic, linked into one
 //! test binary.
 
+mod curving;
 mod dynamics;
 mod equations;
 mod equilibrium;
