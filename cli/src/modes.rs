@@ -44,7 +44,7 @@ pub struct Speeds(pub Vec<f64>);
 
 /// The speeds of `FROM:TO:STEP`, m/s: FROM, FROM + STEP, … up to TO
 /// (included when it falls on the grid, to a millionth of a step).
-fn parse_speeds(text: &str) -> Result<Speeds, String> {
+pub(crate) fn parse_speeds(text: &str) -> Result<Speeds, String> {
     let parts: Vec<&str> = text.split(':').collect();
     let [from, to, step] = parts[..] else {
         return Err(format!("expected FROM:TO:STEP in m/s, got {text:?}"));

@@ -1,7 +1,7 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, equilibrium, info, modes, plot, run, study};
+use railmbs_cli::{bench, conicity, creep, curving, equilibrium, info, modes, plot, run, study};
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +34,8 @@ enum Command {
     Equilibrium(equilibrium::Args),
     /// Linear modes at a scenario's steady state, a root locus over speed, the linear critical speed.
     Modes(modes::Args),
+    /// Quasi-static curving: the steady state of the vehicle in a constant curve at constant speed.
+    Curving(curving::Args),
 }
 
 fn main() {
@@ -48,6 +50,7 @@ fn main() {
         Command::Info(a) => info::run(a),
         Command::Equilibrium(a) => equilibrium::run(a),
         Command::Modes(a) => modes::run(a),
+        Command::Curving(a) => curving::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

@@ -412,23 +412,28 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
                 }
             }
         }
-        let mut dx = match solve_equilibrated(&jac, &r, names, &unknowns, true) {
-            Err(Singular::Loaded) => {
-                // A direction without stiffness that a force pushes along
-                // (a wheel above its rail, gravity on it): a step of damped
-                // motion under the forces, (J − M/τ²) δx = −r, instead
-                // (pseudo-transient continuation; τ = 0.01 s moves a body
-                // by at most g τ² ≈ 1 mm).
-                let tau: f64 = 0.01;
-                let mut regularized = jac.clone();
-                for (a, &(i, _)) in unknowns.map.iter().enumerate() {
-                    for (b, &(j, role)) in unknowns.map.iter().enumerate() {
-                        let scale = if role == Role::Rate { tau } else { tau * tau };
-                        regularized[(a, b)] -= eval.mass()[(i, j)] / scale;
-                    }
+        // A direction without stiffness that a force pushes along (a wheel
+        // above its rail, gravity on it): a step of damped motion under the
+        // forces, (J − M/τ²) δx = −r, instead (pseudo-transient
+        // continuation; τ = 0.01 s moves a body by at most g τ² ≈ 1 mm).
+        let regularized_step = || {
+            let tau: f64 = 0.01;
+            let mut regularized = jac.clone();
+            for (a, &(i, _)) in unknowns.map.iter().enumerate() {
+                for (b, &(j, role)) in unknowns.map.iter().enumerate() {
+                    let scale = if role == Role::Rate { tau } else { tau * tau };
+                    regularized[(a, b)] -= eval.mass()[(i, j)] / scale;
                 }
-                solve_equilibrated(&regularized, &r, names, &unknowns, false)
             }
+            solve_equilibrated(&regularized, &r, names, &unknowns, false)
+        };
+        let mut dx = match solve_equilibrated(&jac, &r, names, &unknowns, true) {
+            Err(Singular::Loaded) => regularized_step(),
+            // A direction without stiffness at the guess is a free one
+            // (named); one that appears on the way (a wheel lifted by a
+            // long step loses its creep forces, and its spin's column
+            // vanishes) is stepped through as a loaded one.
+            Err(Singular::Free(_)) if iterations > 1 => regularized_step(),
             other => other,
         }
         .map_err(|e| match e {

@@ -8,6 +8,10 @@
 //!   full model;
 //! - [`modes`]: eigenvalues, frequencies, damping ratios and mode shapes
 //!   of A, named by their dominant coordinates;
+//! - [`curving`]: the quasi-static curving solution, the equilibrium of a
+//!   vehicle on a circular curve at constant speed in its track-following
+//!   frames, with every wheelset's position, angle of attack and contact
+//!   outputs;
 //! - [`speed`]: all three for a scenario at a speed, root loci over speed
 //!   and the linear critical speed.
 //!
@@ -15,6 +19,7 @@
 //! [`MechanicalSystem::dynamics`] and [`MechanicalSystem::constraints`]:
 //! there is no second model evaluation to keep consistent.
 
+pub mod curving;
 pub mod equilibrium;
 pub mod linear;
 pub mod modes;

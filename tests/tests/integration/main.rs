@@ -1,6 +1,7 @@
 //! The integration tests of `tests`, one module per topic, linked into one
 //! test binary.
 
+mod curving;
 mod dynamics;
 mod equations;
 mod equilibrium;
@@ -12,3 +13,4 @@ mod train;
 mod vehicle2;
 mod wheelset_variants;
 mod wheelsets;
+mod wickens;
