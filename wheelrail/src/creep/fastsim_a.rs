@@ -209,6 +209,22 @@ struct StripSums {
     mz: f64,
 }
 
+/// The strips of a unit ellipse cut across the lateral axis, as FastSim_A
+/// and FastSim_SA integrate over them: per strip its centre e ∈ (−1, 1) and
+/// half-length √(1 − e²); the normalization Σ (half-length)³ · (4/3) · Δe
+/// (→ π/2 as the strips get finer); and the strip width Δe = 2/strips.
+pub(super) fn strip_grid(strips: usize) -> (Vec<(f64, f64)>, f64, f64) {
+    let mf = strips as f64;
+    let strip_geom: Vec<(f64, f64)> = (0..strips)
+        .map(|j| {
+            let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
+            (e, (1.0 - e * e).max(0.0).sqrt())
+        })
+        .collect();
+    let norm = strip_geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
+    (strip_geom, norm, 2.0 / mf)
+}
+
 impl FastsimA {
     /// FastSim_A with `strips` strips.
     pub fn new(strips: usize) -> Result<Self, CreepError> {
@@ -217,18 +233,11 @@ impl FastsimA {
                 "FastSim_A number of strips must be in 1..={MAX_STRIPS}, got {strips}"
             )));
         }
-        let mf = strips as f64;
-        let strip_geom: Vec<(f64, f64)> = (0..strips)
-            .map(|j| {
-                let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
-                (e, (1.0 - e * e).max(0.0).sqrt())
-            })
-            .collect();
-        let norm = strip_geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
+        let (strip_geom, norm, d_eta) = strip_grid(strips);
         Ok(Self {
             strip_geom,
             norm,
-            d_eta: 2.0 / mf,
+            d_eta,
             sliding: SlidingZone::Continuation,
             nodes: Vec::new(),
         })

@@ -34,7 +34,7 @@
 //! `creep` (creepages to 6e-3, mostly sliding) 10 × 10 costs as FASTSIM's
 //! (2.2 million evaluations per second each).
 
-use super::fastsim_a::{StripConsts, adhesion_boundary, adhesion_zone};
+use super::fastsim_a::{StripConsts, adhesion_boundary, adhesion_zone, strip_grid};
 use super::{ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, Flexibilities, validate};
 
 /// Largest number of strips or elements per strip accepted.
@@ -65,18 +65,11 @@ impl FastsimSa {
                 )));
             }
         }
-        let mf = strips as f64;
-        let strip_geom: Vec<(f64, f64)> = (0..strips)
-            .map(|j| {
-                let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
-                (e, (1.0 - e * e).max(0.0).sqrt())
-            })
-            .collect();
-        let norm = strip_geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
+        let (strip_geom, norm, d_eta) = strip_grid(strips);
         Ok(Self {
             strip_geom,
             norm,
-            d_eta: 2.0 / mf,
+            d_eta,
             elements,
         })
     }
