@@ -8,7 +8,7 @@
 //! and wear numbers. A speed range gives one table per speed; the CSV holds
 //! one row per speed and wheelset with all the contact element's outputs.
 
-use crate::engine::{Engine, build_engine};
+use crate::engine::EngineOptions;
 use crate::modes::{Speeds, parse_speeds};
 use railmbs_runtime::analysis::curving::{Curve, Curving, curving_from};
 use railmbs_runtime::forces::ContactTableCache;
@@ -34,15 +34,9 @@ pub struct Args {
     /// CSV: one row per speed and wheelset.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Which equations of motion to use.
-    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
-    pub engine: Engine,
-    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
-    #[arg(long)]
-    pub plugin: Option<PathBuf>,
-    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
-    pub set: Vec<(String, String)>,
+    /// Engine and parameters.
+    #[command(flatten)]
+    pub engine: EngineOptions,
 }
 
 /// One speed (m/s) or `FROM:TO:STEP`.
@@ -60,20 +54,11 @@ fn parse_speed_or_sweep(text: &str) -> Result<Speeds, String> {
 
 /// Runs `umsim curving`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut scenario = railmbs_models::load_scenario(&args.scenario)?;
-    for (name, value) in &args.set {
-        scenario.set_parameter(name, value);
-    }
-    let model = railmbs_models::load_model(&scenario.model)?;
-    let engine = if args.plugin.is_some() {
-        Engine::Symbolic
-    } else {
-        args.engine
-    };
+    let (scenario, model) = args.engine.load(&args.scenario)?;
     let tables = ContactTableCache::new();
-    let plugin = args.plugin.clone();
     let mut make = || -> Result<Box<dyn railmbs_runtime::Equations>, RunError> {
-        build_engine(&model, engine, plugin.as_deref())
+        args.engine
+            .build(&model)
             .map_err(|e| RunError::Sim(railmbs_runtime::SimError::Other(e.to_string())))
     };
     let mut results = Vec::new();

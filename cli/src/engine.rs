@@ -4,7 +4,7 @@ use railmbs_codegen::{GenerateOptions, PluginFile};
 use railmbs_models::Model;
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Which engine computes the equations of motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -77,5 +77,47 @@ pub fn build_engine_with(
             let plugin = Plugin::load_for(&path, model)?;
             Ok(Box::new(PluginEquations::new(plugin)))
         }
+    }
+}
+
+/// The engine and parameter options shared by the analysis commands
+/// (`umsim equilibrium`, `modes`, `curving`), flattened into their clap
+/// arguments.
+#[derive(Debug, clap::Args)]
+pub struct EngineOptions {
+    /// Which equations of motion to use.
+    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
+    pub engine: Engine,
+    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
+    #[arg(long)]
+    pub plugin: Option<PathBuf>,
+    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
+    pub set: Vec<(String, String)>,
+}
+
+impl EngineOptions {
+    /// The scenario file `path` with the `--set` assignments applied, and
+    /// its model.
+    pub fn load(
+        &self,
+        path: &Path,
+    ) -> Result<(railmbs_models::Scenario, Model), Box<dyn std::error::Error>> {
+        let mut scenario = railmbs_models::load_scenario(path)?;
+        for (name, value) in &self.set {
+            scenario.set_parameter(name, value);
+        }
+        let model = railmbs_models::load_model(&scenario.model)?;
+        Ok((scenario, model))
+    }
+
+    /// The engine of `model` as chosen (`--plugin` implies symbolic).
+    pub fn build(&self, model: &Model) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
+        let engine = if self.plugin.is_some() {
+            Engine::Symbolic
+        } else {
+            self.engine
+        };
+        build_engine(model, engine, self.plugin.as_deref())
     }
 }

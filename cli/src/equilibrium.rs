@@ -4,7 +4,7 @@
 //! of the coordinates (long names, units, what the solve did with each) and,
 //! for vehicles, the wheel loads Q and lateral forces Y of every wheel.
 
-use crate::engine::{Engine, build_engine};
+use crate::engine::EngineOptions;
 use railmbs_models::InitialStateKind;
 use railmbs_runtime::analysis::{self, equilibrium::Role};
 use railmbs_runtime::run::scenario::{ScenarioSystem, scenario_system};
@@ -17,31 +17,16 @@ pub struct Args {
     /// Scenario file (RON); its model's `init`/`vel` and the scenario's
     /// `initial` overrides are the starting guess.
     pub scenario: PathBuf,
-    /// Which equations of motion to use.
-    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
-    pub engine: Engine,
-    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
-    #[arg(long)]
-    pub plugin: Option<PathBuf>,
-    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
-    pub set: Vec<(String, String)>,
+    /// Engine and parameters.
+    #[command(flatten)]
+    pub engine: EngineOptions,
 }
 
 /// Runs `umsim equilibrium`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut scenario = railmbs_models::load_scenario(&args.scenario)?;
-    for (name, value) in &args.set {
-        scenario.set_parameter(name, value);
-    }
+    let (mut scenario, model) = args.engine.load(&args.scenario)?;
     scenario.initial_kind = InitialStateKind::Equilibrium;
-    let model = railmbs_models::load_model(&scenario.model)?;
-    let engine = if args.plugin.is_some() {
-        Engine::Symbolic
-    } else {
-        args.engine
-    };
-    let equations = build_engine(&model, engine, args.plugin.as_deref())?;
+    let equations = args.engine.build(&model)?;
     let start = std::time::Instant::now();
     let mut solved = scenario_system(&scenario, &model, equations)?;
     let elapsed = start.elapsed().as_secs_f64();

@@ -6,7 +6,7 @@
 //! speed and mode) and the linear critical speed, where the least damped
 //! lateral (hunting) mode's damping ratio crosses zero.
 
-use crate::engine::{Engine, build_engine};
+use crate::engine::EngineOptions;
 use railmbs_runtime::analysis::modes::Mode;
 use railmbs_runtime::analysis::speed::{SpeedModes, critical_speed, root_locus, scenario_modes};
 use railmbs_runtime::forces::ContactTableCache;
@@ -27,15 +27,9 @@ pub struct Args {
     /// CSV: the modes with their shapes, or with `--speed` the root locus.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Which equations of motion to use.
-    #[arg(long, value_enum, default_value_t = Engine::Numeric)]
-    pub engine: Engine,
-    /// A compiled plugin of the scenario's model (implies `--engine symbolic`).
-    #[arg(long)]
-    pub plugin: Option<PathBuf>,
-    /// Sets a model parameter, `NAME=VALUE` (as for `umsim run`); repeatable.
-    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = crate::run::parse_assignment)]
-    pub set: Vec<(String, String)>,
+    /// Engine and parameters.
+    #[command(flatten)]
+    pub engine: EngineOptions,
 }
 
 /// The running speeds of `--speed`, m/s.
@@ -69,25 +63,17 @@ pub(crate) fn parse_speeds(text: &str) -> Result<Speeds, String> {
 
 /// Runs `umsim modes`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut scenario = railmbs_models::load_scenario(&args.scenario)?;
-    for (name, value) in &args.set {
-        scenario.set_parameter(name, value);
-    }
-    let model = railmbs_models::load_model(&scenario.model)?;
-    let engine = if args.plugin.is_some() {
-        Engine::Symbolic
-    } else {
-        args.engine
-    };
-    let plugin = args.plugin.clone();
+    let (scenario, model) = args.engine.load(&args.scenario)?;
     // Built once (a plugin is compiled or loaded once), then one engine per speed.
     let mut make = {
         let model = model.clone();
-        let mut first = Some(build_engine(&model, engine, plugin.as_deref())?);
+        let mut first = Some(args.engine.build(&model)?);
         move || -> Result<Box<dyn railmbs_runtime::Equations>, RunError> {
             match first.take() {
                 Some(e) => Ok(e),
-                None => build_engine(&model, engine, plugin.as_deref())
+                None => args
+                    .engine
+                    .build(&model)
                     .map_err(|e| RunError::Sim(railmbs_runtime::SimError::Other(e.to_string()))),
             }
         }
