@@ -6,6 +6,7 @@ mod conicity_en15302;
 mod creep;
 mod creepage;
 mod elastic_rail;
+mod exact_theory;
 mod fastsim_sa;
 mod geometry_contact;
 mod hertz;
