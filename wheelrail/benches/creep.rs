@@ -14,7 +14,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use railmbs_wheelrail::creep::{
     ContactPatch, CreepLaw, Creepages, Fastsim, FastsimA, FastsimSa, KalkerLinear, Mueller,
-    MuellerKalkerSaturated, Polach, SlidingZone,
+    MuellerKalkerSaturated, Polach, SlidingZone, StripTheory,
 };
 use std::hint::black_box;
 
@@ -100,6 +100,8 @@ fn bench(c: &mut Criterion) {
                     .unwrap(),
             ),
         ),
+        ("strip 10".into(), Box::new(StripTheory::new(10).unwrap())),
+        ("strip 20".into(), Box::new(StripTheory::new(20).unwrap())),
         ("polach".into(), Box::new(Polach::new())),
         (
             "polach 2005 options".into(),

@@ -22,7 +22,9 @@
 //! - [`FastsimSa`]: FastSim_SA (Pogorelov 2005, Sect. 4.3, Fig. 24): the
 //!   analytic adhesion zone, FASTSIM's elements in the sliding zone;
 //! - [`Polach`]: Polach's closed-form method (1999) with spin, and the 2005
-//!   extension (reduction factors `k_A`, `k_S`, falling friction) as options.
+//!   extension (reduction factors `k_A`, `k_S`, falling friction) as options;
+//! - [`StripTheory`]: strip theory calibrated to Kalker's linear theory, spin
+//!   through FASTSIM's flexibility (FaStrip-like; this project's derivation).
 //!
 //! [`CreepLawSpec`] names a law and its settings (model files, command line)
 //! and builds it.
@@ -35,6 +37,7 @@ mod mueller;
 mod mueller_kalker_saturated;
 mod polach;
 mod spec;
+mod strip;
 
 pub use fastsim::{Fastsim, FastsimLayout, TractionBound};
 pub use fastsim_a::{FastsimA, INTEGRATED_NODES, SlidingZone};
@@ -46,6 +49,7 @@ pub use polach::Polach;
 pub use spec::{
     CREEP_LAW_SYNTAX, CreepLawSpec, FASTSIM_A_STRIPS, FASTSIM_DIVISIONS, ParseCreepLawError,
 };
+pub use strip::{STRIP_THEORY_STRIPS, StripTheory};
 
 pub use crate::creepage::Creepages;
 use crate::kalker::KalkerCoefficients;

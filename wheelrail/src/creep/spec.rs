@@ -18,7 +18,8 @@ use std::str::FromStr;
 
 use super::{
     CreepError, CreepLaw, Fastsim, FastsimA, FastsimSa, INTEGRATED_NODES, KalkerLinear,
-    MUELLER_EXPONENT, Mueller, MuellerKalkerSaturated, Polach, SlidingZone,
+    MUELLER_EXPONENT, Mueller, MuellerKalkerSaturated, Polach, STRIP_THEORY_STRIPS, SlidingZone,
+    StripTheory,
 };
 
 /// Default number of strips of FastSim_A when a command line leaves it out
@@ -49,6 +50,7 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// | `fastsim-a`, `fastsim-a:20`, `fastsim-a:strips=20,sliding=integrated,nodes=8` | [`FastsimA`], default [`FASTSIM_A_STRIPS`] strips, sliding `continuation` (default), `integrated` or `picard` with `nodes` Gauss nodes (default [`INTEGRATED_NODES`]) |
 /// | `fastsim-a-integrated[:STRIPS]` | `fastsim-a:strips=STRIPS,sliding=integrated` |
 /// | `polach`, `polach:ka=0.5,ks=0.3,friction_decrease=0.4/0.6` | [`Polach`], `ka`, `ks` default 1, `friction_decrease` = `A/B` (B in s/m) optional |
+/// | `strip`, `strip:20`, `strip:strips=20` | [`StripTheory`], default [`STRIP_THEORY_STRIPS`] strips |
 ///
 /// [`Display`] writes every setting as `key=value` (for example
 /// `fastsim-a:strips=20,sliding=continuation`), which [`FromStr`] reads back
@@ -61,6 +63,7 @@ pub const FASTSIM_DIVISIONS: usize = 10;
 /// Fastsim(nx: 10, ny: 10) | FastsimSa(nx: 10, ny: 10)
 /// FastsimA(strips: 20, sliding: Continuation)      // or Integrated(nodes: 8), Picard(nodes: 8)
 /// Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))
+/// Strip(strips: 20)
 /// ```
 ///
 /// The Mueller laws' exponent, `FastsimA`'s sliding and all of `Polach`'s settings
@@ -144,6 +147,12 @@ pub enum CreepLawSpec<N = f64> {
         )]
         friction_decrease: Option<(N, N)>,
     },
+    /// Strip theory calibrated to Kalker's linear theory, spin through
+    /// FASTSIM's flexibility ([`StripTheory`], FaStrip-like).
+    Strip {
+        /// Strips across the ellipse (≥ 1).
+        strips: usize,
+    },
 }
 
 impl<N> Default for CreepLawSpec<N> {
@@ -170,6 +179,7 @@ impl<N> CreepLawSpec<N> {
             Self::FastsimSa { .. } => "fastsim-sa",
             Self::FastsimA { .. } => "fastsim-a",
             Self::Polach { .. } => "polach",
+            Self::Strip { .. } => "strip",
         }
     }
 
@@ -217,6 +227,7 @@ impl<N> CreepLawSpec<N> {
                     None => None,
                 },
             },
+            Self::Strip { strips } => CreepLawSpec::Strip { strips: *strips },
         })
     }
 
@@ -227,7 +238,8 @@ impl<N> CreepLawSpec<N> {
             Self::Kalker
             | Self::Fastsim { .. }
             | Self::FastsimSa { .. }
-            | Self::FastsimA { .. } => {}
+            | Self::FastsimA { .. }
+            | Self::Strip { .. } => {}
             Self::Mueller { exponent } | Self::MuellerKalkerSaturated { exponent } => {
                 f("exponent", exponent)
             }
@@ -296,6 +308,9 @@ impl CreepLawSpec<f64> {
                 },
             },
             Self::polach(),
+            Self::Strip {
+                strips: STRIP_THEORY_STRIPS,
+            },
         ]
     }
 
@@ -326,6 +341,7 @@ impl CreepLawSpec<f64> {
                 }
                 Box::new(p)
             }
+            Self::Strip { strips } => Box::new(StripTheory::new(strips)?),
         })
     }
 
@@ -349,6 +365,7 @@ impl<N: Display> Display for CreepLawSpec<N> {
             Self::Fastsim { nx, ny } | Self::FastsimSa { nx, ny } => {
                 write!(f, ":nx={nx},ny={ny}")
             }
+            Self::Strip { strips } => write!(f, ":strips={strips}"),
             Self::FastsimA { strips, sliding } => {
                 write!(f, ":strips={strips},sliding=")?;
                 match sliding {
@@ -387,7 +404,7 @@ pub struct ParseCreepLawError {
 pub const CREEP_LAW_SYNTAX: &str = "kalker | mueller[:EXPONENT] | \
      mueller-kalker-saturated[:EXPONENT] | fastsim[:N] | \
      fastsim:nx=NX,ny=NY | fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY | fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | \
-     fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]";
+     fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B] | strip[:STRIPS]";
 
 /// One `key=value` (or bare `value`, key `None`) of a creep-law text.
 struct Setting<'a> {
@@ -443,6 +460,7 @@ impl FromStr for CreepLawSpec<f64> {
                 (&["strips", "sliding", "nodes"], Some("strips"))
             }
             "polach" => (&["ka", "ks", "friction_decrease"], None),
+            "strip" => (&["strips"], Some("strips")),
             _ => {
                 return Err(fail(format!(
                     "unknown law \"{name}\"; expected {CREEP_LAW_SYNTAX}"
@@ -547,6 +565,9 @@ impl FromStr for CreepLawSpec<f64> {
                 }
                 Self::FastsimA { strips, sliding }
             }
+            "strip" => Self::Strip {
+                strips: count("strips", STRIP_THEORY_STRIPS)?,
+            },
             _ => {
                 let ka = get("ka").map_or(Ok(1.0), |v| real("ka", v))?;
                 let ks = get("ks").map_or(Ok(1.0), |v| real("ks", v))?;
@@ -773,7 +794,8 @@ mod tests {
                 | CreepLawSpec::Fastsim { .. }
                 | CreepLawSpec::FastsimSa { .. }
                 | CreepLawSpec::FastsimA { .. }
-                | CreepLawSpec::Polach { .. } => {}
+                | CreepLawSpec::Polach { .. }
+                | CreepLawSpec::Strip { .. } => {}
             }
         }
         for name in [
@@ -784,6 +806,7 @@ mod tests {
             "fastsim-sa",
             "fastsim-a",
             "polach",
+            "strip",
         ] {
             assert!(names.contains(&name), "{name}");
         }

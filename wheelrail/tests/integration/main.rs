@@ -13,3 +13,4 @@ mod hertz;
 mod mueller;
 mod polach;
 mod profile_reading;
+mod strip;
