@@ -11,7 +11,8 @@
 //! `fastsim[:N]` (N × N) or `fastsim:nx=NX,ny=NY`, `fastsim-sa[:N]` or
 //! `fastsim-sa:nx=NX,ny=NY`, `fastsim-a[:STRIPS]` with
 //! `,sliding=continuation|integrated|picard` and `,nodes=K`,
-//! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`;
+//! `fastsim-a-integrated[:STRIPS]`, `polach[:ka=KA,ks=KS,friction_decrease=A/B]`,
+//! `strip[:STRIPS]` (strip theory calibrated to Kalker's linear theory);
 //! defaults as in model files. FastSim_A's `integrated` sliding zones are more
 //! accurate at large spin, about ten times slower (see
 //! `railmbs_wheelrail::creep::SlidingZone`). The older flags `--strips`,
@@ -55,10 +56,11 @@ pub(crate) const LAW_HELP: &str = concat!(
     "fastsim[:N] (N × N elements) | fastsim:nx=NX,ny=NY | ",
     "fastsim-sa[:N] | fastsim-sa:nx=NX,ny=NY (FastSim_SA: analytic adhesion, FASTSIM sliding) | ",
     "fastsim-a[:STRIPS][,sliding=continuation|integrated|picard][,nodes=K] | ",
-    "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B]. ",
+    "fastsim-a-integrated[:STRIPS] | polach[:ka=KA,ks=KS,friction_decrease=A/B] | ",
+    "strip[:STRIPS] (strip theory with Kalker's coefficients). ",
     "Defaults: Mueller exponents 2, FASTSIM 10 × 10, FastSim_A 20 strips with ",
     "continuation sliding (8 Gauss nodes for integrated/picard), Polach ",
-    "ka = ks = 1 without friction decrease. Example: fastsim-a:10,sliding=integrated"
+    "ka = ks = 1 without friction decrease, strip theory 10 strips. Example: fastsim-a:10,sliding=integrated"
 );
 
 /// Arguments of `umsim creep`.

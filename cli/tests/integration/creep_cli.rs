@@ -204,6 +204,7 @@ fn compare_prints_each_law_and_the_differences() {
         "fastsim-sa:",
         "fastsim-a:",
         "polach:",
+        "strip:",
     ] {
         assert!(
             first.contains(&format!(",{law}")) || first.contains(&format!(",\"{law}")),
