@@ -971,6 +971,8 @@ struct RawCoupler {
 
 /// A coupler of a train file: the linear `Coupler(...)` or any force
 /// element of the model language.
+// Raw syntax lives only while a file is read; size does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 enum RawTrainCoupler {
     Coupler(RawCoupler),
