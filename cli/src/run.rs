@@ -34,6 +34,10 @@ pub struct Args {
     /// Runs to this end time instead of the scenario's, s.
     #[arg(long, value_name = "SECONDS")]
     pub end_time: Option<f64>,
+    /// A train's vehicles are evaluated in N threads (overrides the train
+    /// file's `threads`; 1: sequentially). The output does not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// `NAME=VALUE` of `--set`.
@@ -57,6 +61,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             if let Some(end) = args.end_time {
                 t.set_end_time(end)
                     .map_err(|e| format!("--end-time: {e}"))?;
+            }
+            if let Some(n) = args.threads {
+                if n == 0 {
+                    return Err("--threads: at least 1".into());
+                }
+                t.threads = n;
             }
             return run_train(args, &t);
         }

@@ -19,6 +19,7 @@ mod parameters;
 mod values;
 pub(crate) use attach::{Lookup, Target, add3};
 pub(crate) use bodies::mass_problems;
+pub(crate) use elements::resolve_foreign_forces;
 use include::{Connection, Includes, Loaded, Sub, close_matches};
 use joints::JointBuilder;
 pub(crate) use values::{evaluate_parameters, find_cycles};

@@ -875,6 +875,14 @@ pub struct TrainScenario {
     pub vehicles: Vec<TrainVehicle>,
     /// Couplers, each between bodies of two different vehicles.
     pub couplers: Vec<TrainCoupler>,
+    /// Couplers written as force elements of the model language (any
+    /// element, with `"<vehicle>.<body>"` names), after the `Coupler(...)`
+    /// ones in the output; resolved against the vehicles' models by
+    /// [`TrainScenario::resolve_elements`].
+    pub elements: Vec<TrainElement>,
+    /// Threads evaluating the vehicles (1: sequentially in the calling
+    /// thread); the results do not depend on it.
+    pub threads: usize,
     /// Train-wide parameter overrides (applied to every vehicle whose model
     /// has the parameter; each must be known to at least one model).
     pub parameters: Vec<(String, String)>,
@@ -908,7 +916,9 @@ pub enum AnyScenario {
 struct RawTrain {
     vehicles: Vec<RawVehicle>,
     #[serde(default)]
-    couplers: Vec<RawCoupler>,
+    couplers: Vec<RawTrainCoupler>,
+    #[serde(default, deserialize_with = "some")]
+    threads: Option<usize>,
     #[serde(default)]
     parameters: OrderedMap<Value>,
     end_time: f64,
@@ -957,6 +967,86 @@ struct RawCoupler {
     longitudinal: Option<Vec<(f64, f64)>>,
     #[serde(default)]
     interpolation: crate::Interpolation,
+}
+
+/// A coupler of a train file: the linear `Coupler(...)` or any force
+/// element of the model language.
+// Raw syntax lives only while a file is read; size does not matter.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+enum RawTrainCoupler {
+    Coupler(RawCoupler),
+    Element(crate::forces::RawForce),
+}
+
+/// The constructors a train's `couplers` list accepts.
+static COUPLER_CONSTRUCTORS: std::sync::LazyLock<Vec<&'static str>> =
+    std::sync::LazyLock::new(|| {
+        let mut all = vec!["Coupler"];
+        all.extend_from_slice(crate::forces::CONSTRUCTORS);
+        all
+    });
+
+impl<'de> Deserialize<'de> for RawTrainCoupler {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::{EnumAccess, VariantAccess, Visitor};
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawTrainCoupler;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a coupler or a force element")
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Self::Value, A::Error> {
+                let (crate::forces::Constructor(ctor), variant) = data.variant()?;
+                let expected: &'static [&'static str] = COUPLER_CONSTRUCTORS.as_slice();
+                if ctor == "Coupler" {
+                    variant
+                        .struct_variant(&[], crate::forces::StructOf::<RawCoupler>::default())
+                        .map(RawTrainCoupler::Coupler)
+                } else {
+                    crate::forces::RawForce::from_variant(&ctor, variant, expected)
+                        .map(RawTrainCoupler::Element)
+                }
+            }
+        }
+        d.deserialize_enum("Coupler", COUPLER_CONSTRUCTORS.as_slice(), V)
+    }
+}
+
+/// A coupler of a train written as a force element of the model language
+/// (`Linear6`, `Spring`, `Tabulated`, `LoadFriction`, `PointPlane`…) between
+/// bodies named `"<vehicle>.<body>"`, as read from the train file; its names
+/// are resolved against the vehicles' models by
+/// [`TrainScenario::resolve_elements`].
+#[derive(Debug, Clone)]
+pub struct TrainElement {
+    /// Element name (unique among the train's couplers), prefix of its
+    /// output columns.
+    pub name: String,
+    raw: Arc<crate::forces::RawForce>,
+}
+
+impl PartialEq for TrainElement {
+    /// Same name and same syntax as read (compared through its debug text:
+    /// the raw syntax has no other equality).
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && format!("{:?}", self.raw) == format!("{:?}", other.raw)
+    }
+}
+
+/// A train coupler element resolved against the vehicles' models: its
+/// element with the body indices renumbered to the coupler's own bodies
+/// 0, 1, … (in order of first reference), and which body of which vehicle
+/// each of them is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainForce {
+    /// Element name.
+    pub name: String,
+    /// The element; `BodyRef::Body(i)` (or body index `i`) is `bodies[i]`.
+    pub kind: crate::forces::ForceKind,
+    /// (vehicle index, body index in that vehicle's model) of the element's
+    /// body `i`.
+    pub bodies: Vec<(usize, usize)>,
 }
 
 /// The constructor name of the file's top-level value (`Model`, `Scenario`,
@@ -1116,9 +1206,33 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         ));
     }
     let mut couplers: Vec<TrainCoupler> = Vec::new();
-    for c in raw.couplers {
+    let mut elements: Vec<TrainElement> = Vec::new();
+    let mut names: Vec<String> = Vec::new();
+    for entry in raw.couplers {
+        let c = match entry {
+            RawTrainCoupler::Coupler(c) => c,
+            RawTrainCoupler::Element(f) => {
+                let name = f.name().to_string();
+                if names.contains(&name) || name.is_empty() {
+                    problems.push((
+                        "name".into(),
+                        Some(name.clone()),
+                        format!("coupler \"{name}\""),
+                        "coupler names must be non-empty and unique".into(),
+                    ));
+                }
+                names.push(name.clone());
+                elements.push(TrainElement {
+                    name,
+                    raw: Arc::new(f),
+                });
+                continue;
+            }
+        };
         let element = format!("coupler \"{}\"", c.name);
-        if couplers.iter().any(|d| d.name == c.name) || c.name.is_empty() {
+        let duplicate = names.contains(&c.name);
+        names.push(c.name.clone());
+        if duplicate || c.name.is_empty() {
             problems.push((
                 "name".into(),
                 Some(c.name.clone()),
@@ -1236,6 +1350,14 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
             });
         }
     }
+    if raw.threads == Some(0) {
+        problems.push((
+            "threads".into(),
+            None,
+            String::new(),
+            "threads must be at least 1".into(),
+        ));
+    }
     for (key, literal, element, message) in problems {
         report(&key, literal.as_deref(), element, message);
     }
@@ -1248,6 +1370,8 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         source: path.to_path_buf(),
         vehicles,
         couplers,
+        elements,
+        threads: raw.threads.unwrap_or(1),
         parameters,
         end_time: raw.end_time,
         integrator,
@@ -1399,6 +1523,88 @@ impl TrainScenario {
         }
         if errors.is_empty() {
             Ok(())
+        } else {
+            Err(ModelErrors(errors))
+        }
+    }
+
+    /// The couplers written as force elements ([`TrainScenario::elements`])
+    /// resolved against the vehicles' models (`models` in vehicle order),
+    /// with the model files' own resolution and range checks; body names
+    /// are `"<vehicle>.<body>"`, expressions numbers (a train has no
+    /// parameters of its own). An element needs at least one body of the
+    /// train (one body and ground: an external force on the train), must not
+    /// join bodies of one vehicle only (that belongs in the vehicle's model)
+    /// and cannot be a wheel–rail contact or have first-order states (the
+    /// train has no coordinates of its own for them). Errors name the
+    /// train file, the element and the position.
+    pub fn resolve_elements(&self, models: &[&Model]) -> Result<Vec<TrainForce>, ModelErrors> {
+        if self.elements.is_empty() {
+            return Ok(Vec::new());
+        }
+        let text =
+            crate::error::read_text(&self.source, "train").map_err(|e| ModelErrors(vec![e]))?;
+        let (mut names, mut owner) = (Vec::new(), Vec::new());
+        for (k, (v, m)) in self.vehicles.iter().zip(models).enumerate() {
+            for (b, body) in m.bodies.iter().enumerate() {
+                names.push(format!("{}.{}", v.name, body.name));
+                owner.push((k, b));
+            }
+        }
+        let raws: Vec<&crate::forces::RawForce> = self.elements.iter().map(|e| &*e.raw).collect();
+        let (kinds, mut errors) =
+            crate::load::resolve_foreign_forces(&self.source, &text, &raws, &names);
+        if !errors.is_empty() {
+            return Err(ModelErrors(errors));
+        }
+        let mut out = Vec::new();
+        for (e, mut kind) in self.elements.iter().zip(kinds) {
+            let mut used: Vec<usize> = Vec::new();
+            let mut references = 0;
+            kind.bodies_mut(&mut |b| {
+                references += 1;
+                if !used.contains(b) {
+                    used.push(*b);
+                }
+            });
+            kind.bodies_mut(&mut |b| *b = used.iter().position(|u| u == b).unwrap_or(0));
+            let bodies: Vec<(usize, usize)> = used.iter().map(|&g| owner[g]).collect();
+            let mut problem = |message: String| {
+                errors.push(ModelError {
+                    file: self.source.clone(),
+                    element: format!("coupler \"{}\"", e.name),
+                    message,
+                    position: self.locate(&e.name),
+                });
+            };
+            if matches!(kind, crate::forces::ForceKind::WheelRail(_)) {
+                problem(
+                    "a wheel–rail contact belongs in a vehicle's model, not among the couplers"
+                        .into(),
+                );
+            } else if matches!(kind, crate::forces::ForceKind::SeriesSpringDamper(_)) {
+                problem(
+                    "a SeriesSpring has a first-order state, which couplers between vehicles \
+                     do not support: put it in a vehicle's model"
+                        .into(),
+                );
+            } else if bodies.is_empty() {
+                problem("the element acts on no body of the train".into());
+            } else if references > 1 && bodies.iter().all(|b| b.0 == bodies[0].0) {
+                problem(format!(
+                    "all its bodies belong to vehicle \"{}\": a coupler joins bodies of \
+                     different vehicles (put an element within one vehicle in its model)",
+                    self.vehicles[bodies[0].0].name
+                ));
+            }
+            out.push(TrainForce {
+                name: e.name.clone(),
+                kind,
+                bodies,
+            });
+        }
+        if errors.is_empty() {
+            Ok(out)
         } else {
             Err(ModelErrors(errors))
         }

@@ -149,7 +149,7 @@ impl Evaluation {
 }
 
 /// An engine computing the equations of motion of one model.
-pub trait Equations {
+pub trait Equations: Send {
     /// Short name for messages and benchmark tables ("numeric", "symbolic").
     fn engine_name(&self) -> &str;
     /// Number of generalized coordinates n.

@@ -22,7 +22,7 @@
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
     Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
-    add_generalized_force,
+    add_generalized_force, build_element,
 };
 use crate::model_system::ModelSystem;
 use crate::run::CpuClock;
@@ -36,19 +36,24 @@ use crate::run::{OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
-use railmbs_models::{BodyRef, Expr, Frame, Model, TrainCoupler, TrainScenario};
+use railmbs_models::{BodyRef, Expr, Frame, Model, TrainCoupler, TrainForce, TrainScenario};
+use rayon::prelude::*;
 use std::ops::Range;
 use std::path::Path;
 
-/// A coupler between body `bodies[0]` of vehicle `vehicles[0]` and body
-/// `bodies[1]` of vehicle `vehicles[1]`: a [`Linear6`] element whose two
-/// bodies are those, seen as bodies 0 and 1 of a two-body context.
-#[derive(Debug, Clone)]
+/// A coupler: a force element of the model language between bodies of
+/// different vehicles (the runtime element of its spec, one home for each
+/// element), evaluated with a context whose body `i` is body `bodies[i].1`
+/// of vehicle `bodies[i].0`. The `Coupler(...)` of train files is a
+/// [`Linear6`] between two bodies.
+#[derive(Debug)]
 pub struct Coupler {
     name: String,
-    vehicles: [usize; 2],
-    bodies: [usize; 2],
-    element: Linear6,
+    /// (vehicle, body in that vehicle's model) of the element's body `i`.
+    bodies: Vec<(usize, usize)>,
+    /// The distinct vehicles of `bodies`, in order of first appearance.
+    vehicles: Vec<usize>,
+    element: Box<dyn ForceElement>,
 }
 
 impl Coupler {
@@ -86,12 +91,59 @@ impl Coupler {
             })?;
             element = element.with_longitudinal(f);
         }
-        Ok(Self {
-            name: spec.name.clone(),
-            vehicles: [spec.vehicle1, spec.vehicle2],
-            bodies: [body1, body2],
+        Ok(Self::with_element(
+            spec.name.clone(),
+            vec![(spec.vehicle1, body1), (spec.vehicle2, body2)],
+            Box::new(element),
+        ))
+    }
+
+    /// The coupler of a force element of the train file, resolved against
+    /// the vehicles' models ([`TrainScenario::resolve_elements`]). Elements
+    /// with first-order states (`SeriesSpring`) are not supported between
+    /// vehicles: the train has no coordinates of its own for them (put such
+    /// an element inside a vehicle's model, e.g. a coupler vehicle's).
+    pub fn from_element(spec: &TrainForce) -> Result<Self, SimError> {
+        let mut element = build_element(spec.name.clone(), &spec.kind);
+        element.set_parameters(&[])?;
+        if element.state_count() > 0 {
+            return Err(SimError::Other(format!(
+                "coupler \"{}\": a {} element has first-order states, which couplers between \
+                 vehicles do not support; put it in a vehicle's model",
+                spec.name,
+                spec.kind.constructor()
+            )));
+        }
+        if element.needs_track() {
+            return Err(SimError::Other(format!(
+                "coupler \"{}\": an element that needs the track cannot be a coupler",
+                spec.name
+            )));
+        }
+        Ok(Self::with_element(
+            spec.name.clone(),
+            spec.bodies.clone(),
             element,
-        })
+        ))
+    }
+
+    fn with_element(
+        name: String,
+        bodies: Vec<(usize, usize)>,
+        element: Box<dyn ForceElement>,
+    ) -> Self {
+        let mut vehicles: Vec<usize> = Vec::new();
+        for &(k, _) in &bodies {
+            if !vehicles.contains(&k) {
+                vehicles.push(k);
+            }
+        }
+        Self {
+            name,
+            bodies,
+            vehicles,
+            element,
+        }
     }
 
     /// Long name.
@@ -123,6 +175,35 @@ pub struct TrainSystem {
     g: Vec<DVector<f64>>,
     gq: Vec<DMatrix<f64>>,
     scratch: JacobianScratch,
+    /// Threads evaluating the vehicles in parallel; `None`: sequentially.
+    pool: Option<rayon::ThreadPool>,
+    /// Whether the couplers' element states (stick anchors) have been set
+    /// from an accepted state (the first evaluation sets them).
+    couplers_initialized: bool,
+}
+
+/// Runs `f` on every item (vehicle `k` and its buffers), in vehicle order in
+/// the calling thread or in parallel on `pool`; the items are independent,
+/// so the results are the same either way. The first error in vehicle
+/// order is returned.
+fn each_vehicle<T: Send>(
+    pool: Option<&rayon::ThreadPool>,
+    items: &mut [T],
+    f: impl Fn(usize, &mut T) -> Result<(), SimError> + Sync,
+) -> Result<(), SimError> {
+    match pool {
+        None => items.iter_mut().enumerate().try_for_each(|(k, x)| f(k, x)),
+        Some(pool) => {
+            let results: Vec<Result<(), SimError>> = pool.install(|| {
+                items
+                    .par_iter_mut()
+                    .enumerate()
+                    .map(|(k, x)| f(k, x))
+                    .collect()
+            });
+            results.into_iter().collect()
+        }
+    }
 }
 
 impl std::fmt::Debug for TrainSystem {
@@ -143,7 +224,7 @@ impl TrainSystem {
     ) -> Result<Self, SimError> {
         let (names, mut systems): (Vec<String>, Vec<ModelSystem>) = vehicles.into_iter().unzip();
         for c in &couplers {
-            for (&k, &b) in c.vehicles.iter().zip(&c.bodies) {
+            for &(k, b) in &c.bodies {
                 let Some(s) = systems.get_mut(k) else {
                     return Err(SimError::Other(format!(
                         "coupler \"{}\": no vehicle {k} in a train of {}",
@@ -184,12 +265,32 @@ impl TrainSystem {
                 .map(|s| DMatrix::zeros(s.n_constraints(), s.dof()))
                 .collect(),
             scratch: JacobianScratch::new(n),
+            pool: None,
+            couplers_initialized: false,
             names,
             vehicles: systems,
             ranges,
             constraint_ranges,
             couplers,
         })
+    }
+
+    /// Evaluates the vehicles in `threads` threads (1: sequentially in the
+    /// calling thread, the default); results are identical either way (the
+    /// vehicles are independent between coupler evaluations: Pogorelov
+    /// 2005, Sect. 5).
+    pub fn set_threads(&mut self, threads: usize) -> Result<(), SimError> {
+        self.pool = if threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .map_err(|e| SimError::Other(format!("cannot start {threads} threads: {e}")))?,
+            )
+        } else {
+            None
+        };
+        Ok(())
     }
 
     /// Number of vehicles.
@@ -249,10 +350,34 @@ impl TrainSystem {
         String::new()
     }
 
-    /// Kinematics of both bodies of coupler `c` from the vehicles' last
+    /// Kinematics of the bodies of coupler `c` from the vehicles' last
     /// evaluations.
-    fn coupler_bodies(&self, c: &Coupler) -> [BodyKinematics; 2] {
-        [0, 1].map(|i| self.vehicles[c.vehicles[i]].last_evaluation().bodies[c.bodies[i]])
+    fn coupler_bodies(&self, c: &Coupler) -> Vec<BodyKinematics> {
+        c.bodies
+            .iter()
+            .map(|&(k, b)| self.vehicles[k].last_evaluation().bodies[b])
+            .collect()
+    }
+
+    /// Tells the couplers whose elements keep state (stick anchors) that the
+    /// vehicles' last evaluations are at an accepted state.
+    fn accept_couplers(&mut self, t: f64) -> Result<(), SimError> {
+        self.couplers_initialized = true;
+        for ci in 0..self.couplers.len() {
+            if !self.couplers[ci].element.remembers_accepted_steps() {
+                continue;
+            }
+            let bodies = self.coupler_bodies(&self.couplers[ci]);
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+                states: &[],
+                state_rates: &[],
+            };
+            self.couplers[ci].element.accept_step(&ctx)?;
+        }
+        Ok(())
     }
 
     /// Coupler outputs at a state (evaluates the coupled vehicles'
@@ -265,9 +390,9 @@ impl TrainSystem {
         out: &mut Vec<f64>,
     ) -> Result<(), SimError> {
         for ci in 0..self.couplers.len() {
-            let mut bodies = [BodyKinematics::default(); 2];
+            let mut bodies = vec![BodyKinematics::default(); self.couplers[ci].bodies.len()];
             for (i, body) in bodies.iter_mut().enumerate() {
-                let (k, b) = (self.couplers[ci].vehicles[i], self.couplers[ci].bodies[i]);
+                let (k, b) = self.couplers[ci].bodies[i];
                 let r = self.ranges[k].clone();
                 let e = self.vehicles[k].evaluate(t, &q[r.clone()], &v[r], Parts::KINEMATICS)?;
                 *body = e.bodies[b];
@@ -310,18 +435,25 @@ impl MechanicalSystem for TrainSystem {
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
         mass.as_mut_slice().fill(0.0);
-        for (k, s) in self.vehicles.iter_mut().enumerate() {
-            let r = self.ranges[k].clone();
-            s.dynamics(
-                t,
-                &q[r.clone()],
-                &v[r.clone()],
-                &mut self.mass[k],
-                &mut self.force[k],
-            )?;
+        {
+            let ranges = &self.ranges;
+            let mut items: Vec<_> = self
+                .vehicles
+                .iter_mut()
+                .zip(self.mass.iter_mut().zip(self.force.iter_mut()))
+                .collect();
+            each_vehicle(self.pool.as_ref(), &mut items, |k, (s, (m, f))| {
+                let r = ranges[k].clone();
+                s.dynamics(t, &q[r.clone()], &v[r], m, f)
+            })?;
+        }
+        for (k, r) in self.ranges.iter().enumerate() {
             mass.view_mut((r.start, r.start), (r.len(), r.len()))
                 .copy_from(&self.mass[k]);
             force.rows_mut(r.start, r.len()).copy_from(&self.force[k]);
+        }
+        if !self.couplers_initialized {
+            self.accept_couplers(t)?;
         }
         for c in &self.couplers {
             let bodies = self.coupler_bodies(c);
@@ -332,9 +464,9 @@ impl MechanicalSystem for TrainSystem {
                 states: &[],
                 state_rates: &[],
             };
-            let mut w = [Wrench::default(); 2];
+            let mut w = vec![Wrench::default(); bodies.len()];
             c.element.apply(&ctx, &mut w)?;
-            for ((&k, &b), w) in c.vehicles.iter().zip(&c.bodies).zip(&w) {
+            for (&(k, b), w) in c.bodies.iter().zip(&w) {
                 let r = self.ranges[k].clone();
                 add_generalized_force(
                     &self.vehicles[k].last_evaluation().jacobians,
@@ -384,17 +516,44 @@ impl MechanicalSystem for TrainSystem {
     ) -> Result<bool, SimError> {
         dfdq.as_mut_slice().fill(0.0);
         dfdv.as_mut_slice().fill(0.0);
-        for (k, s) in self.vehicles.iter_mut().enumerate() {
-            let r = self.ranges[k].clone();
-            if !s.force_jacobian(
-                t,
-                &q[r.clone()],
-                &v[r.clone()],
-                &mut self.dq[k],
-                &mut self.dv[k],
-            )? {
-                return Ok(false);
-            }
+        // A vehicle without force elements of its own (a coupler vehicle,
+        // moved by the couplers only) has a zero approximate Jacobian
+        // (Eq. 31 neglects the inertia and gravity terms); any other vehicle
+        // without one makes the integrator differentiate the train.
+        let coupled: Vec<bool> = (0..self.vehicles.len())
+            .map(|k| self.couplers.iter().any(|c| c.vehicles.contains(&k)))
+            .collect();
+        let analytic: Vec<bool> = {
+            let ranges = &self.ranges;
+            let mut items: Vec<_> = self
+                .vehicles
+                .iter_mut()
+                .zip(self.dq.iter_mut().zip(self.dv.iter_mut()))
+                .map(|x| (x, true))
+                .collect();
+            each_vehicle(self.pool.as_ref(), &mut items, |k, ((s, (dq, dv)), ok)| {
+                let r = ranges[k].clone();
+                *ok = s.force_jacobian(t, &q[r.clone()], &v[r.clone()], dq, dv)?;
+                if !*ok && coupled[k] && s.forces().is_empty() {
+                    // Its body Jacobians at this state, for the couplers.
+                    let parts = Parts {
+                        kinematics: true,
+                        jacobians: true,
+                        ..Parts::KINEMATICS
+                    };
+                    s.evaluate(t, &q[r.clone()], &v[r], parts)?;
+                    dq.as_mut_slice().fill(0.0);
+                    dv.as_mut_slice().fill(0.0);
+                    *ok = true;
+                }
+                Ok(())
+            })?;
+            items.iter().map(|x| x.1).collect()
+        };
+        if analytic.contains(&false) {
+            return Ok(false);
+        }
+        for (k, r) in self.ranges.iter().enumerate() {
             dfdq.view_mut((r.start, r.start), (r.len(), r.len()))
                 .copy_from(&self.dq[k]);
             dfdv.view_mut((r.start, r.start), (r.len(), r.len()))
@@ -402,22 +561,29 @@ impl MechanicalSystem for TrainSystem {
         }
         for c in &self.couplers {
             let bodies = self.coupler_bodies(c);
-            let ranges = c.vehicles.map(|k| self.ranges[k].clone());
-            let (n1, n2) = (ranges[0].len(), ranges[1].len());
-            // Γ of both bodies side by side: rows 0–5 body 1 over vehicle 1's
-            // columns, rows 6–11 body 2 over vehicle 2's.
-            let mut gamma = DMatrix::zeros(12, n1 + n2);
-            for (i, range) in ranges.iter().enumerate() {
-                let src = &self.vehicles[c.vehicles[i]].last_evaluation().jacobians;
-                let col0 = if i == 0 { 0 } else { n1 };
-                // The coordinates' columns; element states after them stay zero.
-                let n = range.len().min(src.ncols());
-                gamma
-                    .view_mut((6 * i, col0), (6, n))
-                    .copy_from(&src.view((6 * c.bodies[i], 0), (6, n)));
+            let ranges: Vec<Range<usize>> =
+                c.vehicles.iter().map(|&k| self.ranges[k].clone()).collect();
+            // Column offset of each of the coupler's vehicles.
+            let mut col0 = Vec::with_capacity(ranges.len());
+            let mut width = 0;
+            for r in &ranges {
+                col0.push(width);
+                width += r.len();
             }
-            let mut dq = DMatrix::zeros(n1 + n2, n1 + n2);
-            let mut dv = DMatrix::zeros(n1 + n2, n1 + n2);
+            // Γ of the bodies stacked: rows 6i..6i+6 body i over its
+            // vehicle's columns.
+            let mut gamma = DMatrix::zeros(6 * c.bodies.len(), width);
+            for (i, &(k, b)) in c.bodies.iter().enumerate() {
+                let j = c.vehicles.iter().position(|&x| x == k).unwrap_or(0);
+                let src = &self.vehicles[k].last_evaluation().jacobians;
+                // The coordinates' columns; element states after them stay zero.
+                let n = ranges[j].len().min(src.ncols());
+                gamma
+                    .view_mut((6 * i, col0[j]), (6, n))
+                    .copy_from(&src.view((6 * b, 0), (6, n)));
+            }
+            let mut dq = DMatrix::zeros(width, width);
+            let mut dv = DMatrix::zeros(width, width);
             let ctx = ForceContext {
                 t,
                 bodies: &bodies,
@@ -428,14 +594,11 @@ impl MechanicalSystem for TrainSystem {
             let mut jac = ForceJacobian::new(&gamma, &bodies, &mut dq, &mut dv, &mut self.scratch);
             c.element.add_jacobian(&ctx, &mut jac)?;
             let global = |i: usize| {
-                if i < n1 {
-                    ranges[0].start + i
-                } else {
-                    ranges[1].start + i - n1
-                }
+                let j = col0.iter().rposition(|&c0| c0 <= i).unwrap_or(0);
+                ranges[j].start + i - col0[j]
             };
-            for a in 0..n1 + n2 {
-                for b in 0..n1 + n2 {
+            for a in 0..width {
+                for b in 0..width {
                     if dq[(a, b)] != 0.0 {
                         dfdq[(global(a), global(b))] += dq[(a, b)];
                     }
@@ -449,15 +612,33 @@ impl MechanicalSystem for TrainSystem {
     }
 
     fn accept_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
-        for (k, s) in self.vehicles.iter_mut().enumerate() {
-            let r = self.ranges[k].clone();
-            s.accept_step(t, &q[r.clone()], &v[r])?;
-        }
-        Ok(())
+        // The coupled vehicles' kinematics at the accepted state, if a
+        // coupler keeps state.
+        let needed: Vec<bool> = (0..self.vehicles.len())
+            .map(|k| {
+                self.couplers
+                    .iter()
+                    .any(|c| c.element.remembers_accepted_steps() && c.vehicles.contains(&k))
+            })
+            .collect();
+        let ranges = &self.ranges;
+        each_vehicle(self.pool.as_ref(), &mut self.vehicles, |k, s| {
+            let r = ranges[k].clone();
+            s.accept_step(t, &q[r.clone()], &v[r.clone()])?;
+            if needed[k] {
+                s.evaluate(t, &q[r.clone()], &v[r], Parts::KINEMATICS)?;
+            }
+            Ok(())
+        })?;
+        self.accept_couplers(t)
     }
 
     fn remembers_accepted_steps(&self) -> bool {
         self.vehicles.iter().any(|s| s.remembers_accepted_steps())
+            || self
+                .couplers
+                .iter()
+                .any(|c| c.element.remembers_accepted_steps())
     }
 }
 
@@ -602,11 +783,23 @@ pub fn build_train(
         );
         couplers.push(coupler);
     }
+    for f in train.resolve_elements(models)? {
+        let coupler = Coupler::from_element(&f).map_err(|e| setup(e.to_string()))?;
+        header.extend(
+            coupler
+                .output_names()
+                .iter()
+                .map(|s| format!("{}.{s}", f.name)),
+        );
+        couplers.push(coupler);
+    }
+    let mut system = TrainSystem::new(vehicles, couplers)?;
+    system.set_threads(train.threads)?;
     if arc.is_none() {
         header.remove(1);
     }
     Ok(TrainSetup {
-        system: TrainSystem::new(vehicles, couplers)?,
+        system,
         q0,
         v0,
         breakpoints,

@@ -199,6 +199,22 @@ macro_rules! force_elements {
                     $( RawForce::$ctor(r) => ForceKind::$variant(r.resolve(cx, w, lookup)), )*
                 }
             }
+
+            /// Reads the fields of the element with constructor `ctor` from a
+            /// RON enum variant (model files, and the couplers of train
+            /// files); an unknown constructor is an error listing `expected`.
+            pub(crate) fn from_variant<'de, A: VariantAccess<'de>>(
+                ctor: &str,
+                variant: A,
+                expected: &'static [&'static str],
+            ) -> Result<RawForce, A::Error> {
+                match ctor {
+                    $( stringify!($ctor) => variant
+                        .struct_variant(&[], StructOf::<$raw>::default())
+                        .map(RawForce::$ctor), )*
+                    other => Err(de::Error::unknown_variant(other, expected)),
+                }
+            }
         }
 
         impl<'de> Deserialize<'de> for RawForce {
@@ -211,12 +227,7 @@ macro_rules! force_elements {
                     }
                     fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<RawForce, A::Error> {
                         let (Constructor(ctor), variant) = data.variant()?;
-                        match ctor.as_str() {
-                            $( stringify!($ctor) => variant
-                                .struct_variant(&[], StructOf::<$raw>::default())
-                                .map(RawForce::$ctor), )*
-                            other => Err(de::Error::unknown_variant(other, CONSTRUCTORS)),
-                        }
+                        RawForce::from_variant(&ctor, variant, CONSTRUCTORS)
                     }
                 }
                 d.deserialize_enum("Force", CONSTRUCTORS, V)
@@ -254,7 +265,7 @@ force_elements! {
 
 /// A RON constructor name (an identifier, so that RON records it for its
 /// error messages).
-struct Constructor(String);
+pub(crate) struct Constructor(pub(crate) String);
 
 impl<'de> Deserialize<'de> for Constructor {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -274,7 +285,7 @@ impl<'de> Deserialize<'de> for Constructor {
 
 /// Reads a struct variant's fields into the raw struct `T` (which carries the
 /// field list, defaults and `deny_unknown_fields` itself).
-struct StructOf<T>(std::marker::PhantomData<T>);
+pub(crate) struct StructOf<T>(std::marker::PhantomData<T>);
 
 impl<T> Default for StructOf<T> {
     fn default() -> Self {

@@ -171,3 +171,44 @@ impl Cx<'_> {
         out
     }
 }
+
+/// Resolves force elements written outside a model file (the couplers of a
+/// train file, `text` of `file`) against the bodies `bodies` (long names;
+/// index = the body index in the result), without parameters: the same
+/// resolution and range checks as a model file's own elements, errors
+/// located in `text`.
+pub(crate) fn resolve_foreign_forces(
+    file: &Path,
+    text: &str,
+    raws: &[&crate::forces::RawForce],
+    bodies: &[String],
+) -> (Vec<ForceKind>, Vec<ModelError>) {
+    let mut cx = Cx {
+        file,
+        loc: Locator::new(text),
+        errors: Vec::new(),
+        nested: Vec::new(),
+        failed: Vec::new(),
+        names: Vec::new(),
+        defaults: Some(Vec::new()),
+        track_offsets: HashMap::new(),
+    };
+    let mut lookup = Lookup {
+        names: HashMap::new(),
+    };
+    for (i, name) in bodies.iter().enumerate() {
+        lookup
+            .names
+            .insert(name.clone(), Target::Body(BodyRef::Body(i)));
+    }
+    let mut out = Vec::new();
+    for (i, f) in raws.iter().enumerate() {
+        let name = f.name();
+        let nth = raws[..i].iter().filter(|o| o.name() == name).count();
+        let w = Where::Elem(FORCE, name.to_string(), nth);
+        let kind = f.resolve(&mut cx, &w, &lookup);
+        cx.check(&w, &kind);
+        out.push(kind);
+    }
+    (out, cx.errors)
+}

@@ -6,7 +6,12 @@ use railmbs_testkit::model_files;
 #[test]
 fn bundled_models_load() {
     let mut problems = Vec::new();
-    for folder in ["mechanisms", "mechanisms/subsystems", "vehicles"] {
+    for folder in [
+        "mechanisms",
+        "mechanisms/subsystems",
+        "vehicles",
+        "vehicles/couplers",
+    ] {
         for path in model_files(folder) {
             match load_model(&path) {
                 Ok(m) => {
@@ -41,6 +46,7 @@ fn bundled_scenarios_resolve() {
                 for c in &train.couplers {
                     train.resolve_coupler(c, &refs)?;
                 }
+                train.resolve_elements(&refs)?;
                 for (k, model) in models.iter().enumerate() {
                     resolve(&train.vehicle_scenario(k, model), model)?;
                 }

@@ -170,28 +170,30 @@ pub trait ForceElement: std::fmt::Debug + Send {
     fn add_jacobian(&self, ctx: &ForceContext, jac: &mut ForceJacobian) -> Result<(), SimError>;
 }
 
-/// Builds the runtime force elements of a model: the registry, one line per
-/// element, each built from its own model spec.
+/// Builds the runtime force elements of a model, each from its own model
+/// spec ([`build_element`]).
 pub fn build(model: &Model) -> Vec<Box<dyn ForceElement>> {
     model
         .forces
         .iter()
-        .map(|f| -> Box<dyn ForceElement> {
-            let name = f.name.clone();
-            match &f.kind {
-                ForceKind::Bipolar(spec) => Box::new(LinearBipolar::new(name, spec)),
-                ForceKind::SeriesSpringDamper(spec) => {
-                    Box::new(SeriesSpringDamper::new(name, spec))
-                }
-                ForceKind::Linear6(spec) => Box::new(Linear6::new(name, spec)),
-                ForceKind::PointPlane(spec) => Box::new(PointPlane::new(name, spec)),
-                ForceKind::Coulomb(spec) => Box::new(CoulombFriction::new(name, spec)),
-                ForceKind::LoadFriction(spec) => Box::new(LoadFriction::new(name, spec)),
-                ForceKind::Tabulated(spec) => Box::new(Tabulated::new(name, spec)),
-                ForceKind::WheelRail(spec) => Box::new(WheelRailContact::new(name, spec)),
-                ForceKind::Applied(spec) => Box::new(AppliedForce::new(name, spec)),
-                ForceKind::TorsionSpring(spec) => Box::new(torsion::TorsionSpring::new(name, spec)),
-            }
-        })
+        .map(|f| build_element(f.name.clone(), &f.kind))
         .collect()
+}
+
+/// Builds the runtime force element `name` of the model spec `kind` (the
+/// registry, one line per element; its body indices are those of the
+/// [`ForceContext::bodies`] it will be evaluated with).
+pub fn build_element(name: String, kind: &ForceKind) -> Box<dyn ForceElement> {
+    match kind {
+        ForceKind::Bipolar(spec) => Box::new(LinearBipolar::new(name, spec)),
+        ForceKind::SeriesSpringDamper(spec) => Box::new(SeriesSpringDamper::new(name, spec)),
+        ForceKind::Linear6(spec) => Box::new(Linear6::new(name, spec)),
+        ForceKind::PointPlane(spec) => Box::new(PointPlane::new(name, spec)),
+        ForceKind::Coulomb(spec) => Box::new(CoulombFriction::new(name, spec)),
+        ForceKind::LoadFriction(spec) => Box::new(LoadFriction::new(name, spec)),
+        ForceKind::Tabulated(spec) => Box::new(Tabulated::new(name, spec)),
+        ForceKind::WheelRail(spec) => Box::new(WheelRailContact::new(name, spec)),
+        ForceKind::Applied(spec) => Box::new(AppliedForce::new(name, spec)),
+        ForceKind::TorsionSpring(spec) => Box::new(torsion::TorsionSpring::new(name, spec)),
+    }
 }

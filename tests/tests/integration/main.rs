@@ -10,6 +10,7 @@ mod plugins;
 mod symbolic;
 mod track_frames;
 mod train;
+mod train_couplers;
 mod vehicle2;
 mod wheelset_variants;
 mod wheelsets;
