@@ -6,7 +6,7 @@ use crate::reduce::{CaseReducer, Cell};
 use crate::{Case, StudyError};
 use railmbs_models::Model;
 use railmbs_runtime::forces::ContactTableCache;
-use railmbs_runtime::run::{CsvFile, Interruptible, OutputSink, RunError, run_scenario_with};
+use railmbs_runtime::run::{Interruptible, OutputSink, RunError, run_scenario_with};
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -47,7 +47,8 @@ pub struct StudyEngine {
 /// Options of one case's run.
 #[derive(Debug, Clone, Default)]
 pub struct CaseOptions {
-    /// Write the case's output rows as `<case id>.csv` in this folder.
+    /// Write the case's output rows as `<case id>.csv` (or `.parquet`, the
+    /// study's [`series_format`](Study::series_format)) in this folder.
     pub series_dir: Option<PathBuf>,
     /// Stop the run at its next output row when set (Ctrl-C).
     pub stop: Option<Arc<AtomicBool>>,
@@ -287,8 +288,8 @@ impl StudyEngine {
         let mut series = options
             .series_dir
             .as_ref()
-            .map(|d| CsvFile::new(d.join(format!("{}.csv", case.id))));
-        let inner = series.as_mut().map(|s| s as &mut dyn OutputSink);
+            .map(|d| study.series_format.sink(d, &case.id));
+        let inner = series.as_mut().map(|s| s.as_mut() as &mut dyn OutputSink);
         let mut reducer = CaseReducer::new(&study.reductions, inner);
         let flag = options.stop.clone().unwrap_or_default();
         let run = {
