@@ -218,8 +218,8 @@ impl StudyEngine {
         self.plugins.iter().map(Plugin::path).collect()
     }
 
-    /// Wheel–rail contact tables built so far (shared by the cases of a
-    /// single-vehicle study; a train's runs build their own).
+    /// Wheel–rail contact tables built so far (shared by the cases of the
+    /// study, and by the vehicles of a train).
     pub fn contact_tables(&self) -> usize {
         self.tables.len()
     }
@@ -317,7 +317,14 @@ impl StudyEngine {
                         .iter()
                         .map(|&k| self.equations(study, k))
                         .collect();
-                    railmbs_runtime::train::run_train_into(t, &models, engines, &mut sink, |_| {})
+                    railmbs_runtime::train::run_train_with(
+                        t,
+                        &models,
+                        engines,
+                        &mut sink,
+                        |_| {},
+                        &self.tables,
+                    )
                 }
             }
         };

@@ -357,6 +357,21 @@ fn a_train_study_builds_one_plugin_for_its_identical_vehicles_and_matches_a_trai
         max
     );
     assert_eq!(number(&study, &record, "assessment.wheelsets"), 12.0);
+
+    // The train's cases share the engine's contact tables: the 12 wheelsets
+    // (one profile pair on one track) built one table in the first case, and
+    // the next cases build none (the cache holds each table it built once)
+    // and give the same numbers as a run that built its own.
+    assert_eq!(engine.contact_tables(), 1);
+    let other = engine
+        .run_case(&study, &study.cases()[0], &CaseOptions::default())
+        .unwrap();
+    assert_eq!(other.status, CaseStatus::Ok, "{:?}", other.error);
+    let again = engine
+        .run_case(&study, &study.cases()[1], &CaseOptions::default())
+        .unwrap();
+    assert_eq!(engine.contact_tables(), 1, "no table built again");
+    assert_eq!(again.values, result.values);
 }
 
 /// The values of a CSV time series, by column, parsed (Rust's shortest
