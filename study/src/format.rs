@@ -345,14 +345,6 @@ impl Study {
                 (CaseSource::LatinHypercube { samples, seed }, vars, rows)
             }
         };
-        if raw.series_format.is_some() && !raw.time_series {
-            p.at(
-                None,
-                "series_format",
-                "series_format",
-                "series_format has no effect without `time_series: true`".into(),
-            );
-        }
         cases::check_variables(&variables, &set, &models, &scenario, &mut p);
         let reductions = reductions(raw.reductions, &mut p);
         let mut study = Study {

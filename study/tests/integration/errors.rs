@@ -28,13 +28,6 @@ fn bad_study_files_get_located_errors() {
         ),
         (
             format!(
-                "Study(\n  scenario: \"{s}\",\n  cases: Grid({{ \"k\": [1] }}),\n  series_format: Parquet,\n)"
-            ),
-            ":4:3",
-            "without `time_series: true`",
-        ),
-        (
-            format!(
                 "Study(\n  scenario: \"{s}\",\n  cases: Grid({{ \"k\": [1] }}),\n  time_series: true, series_format: Arrow,\n)"
             ),
             ":4:",
