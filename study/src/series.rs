@@ -51,7 +51,7 @@ const ROW_GROUP_ROWS: usize = 8192;
 
 /// A Parquet file of the output rows: a schema of one required `DOUBLE`
 /// column per header name (in order), written as row groups of
-/// [`ROW_GROUP_ROWS`] rows, uncompressed and plain-encoded (no dictionary),
+/// 8192 rows, uncompressed and plain-encoded (no dictionary),
 /// so the values are the computed `f64`s bit for bit. The file is written
 /// as `<path>.partial` and renamed to `path` when the run ends
 /// ([`OutputSink::finish`], also after a simulation error, with the rows up
