@@ -133,7 +133,12 @@ class Study:
     def variables(self) -> List[str]: ...
     @property
     def time_series(self) -> bool:
-        """Whether each case's output is written as ``series/<case id>.csv``."""
+        """Whether each case's output is written as ``series/<case id>.csv``
+        (or ``.parquet``: ``series_format``)."""
+    @property
+    def series_format(self) -> str:
+        """The format of the time series files: ``"csv"`` or ``"parquet"``
+        (one DOUBLE column per output column, the values bit for bit)."""
     def cases(self) -> List[Dict[str, Any]]:
         """The cases in index order: dicts with ``index`` (int), ``id`` (16
         hex digits, stable across machines and runs) and ``inputs``

@@ -65,6 +65,7 @@ __all__ = [
     "engine",
     "load",
     "read_results",
+    "read_series",
     "run",
     "run_case",
     "worker_builds",
@@ -154,6 +155,29 @@ def read_results(output_dir: _PathLike) -> Any:
     df = pd.read_csv(path, dtype={"case_id": str, "status": str, "error": str})
     df["error"] = df["error"].fillna("")
     return df.sort_values("index", kind="stable").reset_index(drop=True)
+
+
+def read_series(output_dir: _PathLike, case_id: str) -> Any:
+    """The time series of case ``case_id`` of the study run into
+    ``output_dir`` (a study with ``time_series: true``) as a pandas
+    DataFrame, one column per output column (the names of the CSV header,
+    units in brackets), one row per output row: ``series/<case id>.parquet``
+    (read with pyarrow) or ``series/<case id>.csv``, whichever is there.
+    The values are the computed floats exactly, in either format."""
+    import pandas as pd
+
+    folder = Path(output_dir) / "series"
+    parquet = folder / f"{case_id}.parquet"
+    if parquet.exists():
+        import pyarrow.parquet as pq
+
+        return pq.read_table(parquet).to_pandas()
+    # Every column is a float (a whole number such as "30" too). Before
+    # pandas 3 the default parser may be an ulp off the shortest round-trip
+    # text Rust writes; "round_trip" reads it exactly (pandas 3 does so by
+    # default and deprecates the option).
+    exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+    return pd.read_csv(folder / f"{case_id}.csv", dtype="float64", **exact)
 
 
 class _Progress:

@@ -161,10 +161,18 @@ impl Study {
         self.inner.variables.clone()
     }
 
-    /// Whether each case's output is written as `series/<case id>.csv`.
+    /// Whether each case's output is written as `series/<case id>.csv`
+    /// (or `.parquet`: `series_format`).
     #[getter]
     fn time_series(&self) -> bool {
         self.inner.time_series
+    }
+
+    /// The format of the time series files: `"csv"` or `"parquet"` (the
+    /// file extension).
+    #[getter]
+    fn series_format(&self) -> &'static str {
+        self.inner.series_format.extension()
     }
 
     /// The cases in index order, each a dict: `index` (int), `id` (16 hex
@@ -288,9 +296,10 @@ impl StudyEngine {
     /// text, in `Study.result_header()` order (times in s). A run that fails
     /// (diverges, a bad parameter value) is a row with status `failed` and
     /// its error, not an exception. `series_dir`: write the case's output
-    /// as `<case id>.csv` there. The GIL is released during the run;
-    /// Ctrl-C stops it (KeyboardInterrupt). Errors: `railmbs.StudyError`
-    /// when a reduction fits no output column (a fault of the study file).
+    /// as `<case id>.csv` (or `.parquet`: `Study.series_format`) there.
+    /// The GIL is released during the run; Ctrl-C stops it
+    /// (KeyboardInterrupt). Errors: `railmbs.StudyError` when a reduction
+    /// fits no output column (a fault of the study file).
     #[pyo3(signature = (case, series_dir = None))]
     fn run_case(
         &self,

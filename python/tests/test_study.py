@@ -309,3 +309,55 @@ def test_a_worker_without_the_clients_plugin_file_builds_it_through_its_cache(st
     assert rs.StudyEngine.from_plugins(other, shipped.plugin_paths).builds()["loaded"] == 1
     with pytest.raises(railmbs.PluginError, match="plugin file"):
         rs.StudyEngine.from_plugins(other, [])
+
+
+# Two cases of the tiny study with their time series, in either format.
+SERIES = """Study(
+    scenario: "{scenario}",
+    end_time: Some(0.3),
+    cases: Grid({{ "mu": [0.3, 0.4] }}),
+    reductions: [Max(column: "contact.L.Y [N]")],
+    time_series: true,
+    series_format: {format},
+)
+"""
+
+
+def test_parquet_time_series_equal_the_csv_time_series_bit_for_bit(tmp_path, request):
+    """The Parquet file of a case, read back with pyarrow, holds the CSV's
+    columns (names and order) and values bit for bit; a Dask worker writes
+    the same file as the local pool."""
+    import numpy as np
+
+    pq = pytest.importorskip("pyarrow.parquet")
+    paths = {}
+    for fmt in ("Csv", "Parquet"):
+        paths[fmt] = tmp_path / f"{fmt}.ron"
+        paths[fmt].write_text(SERIES.format(scenario=SCENARIOS / "wheelset_on_springs_30.ron", format=fmt))
+    assert rs.load(paths["Parquet"]).series_format == "parquet"
+    assert rs.load(paths["Csv"]).series_format == "csv"
+    rs.run(paths["Csv"], tmp_path / "csv", progress=False)
+    rs.run(paths["Parquet"], tmp_path / "pq", progress=False)
+    ids = [c["id"] for c in rs.load(paths["Csv"]).cases()]
+    for case_id in ids:
+        with open(tmp_path / "csv" / "series" / f"{case_id}.csv", newline="") as f:
+            rows = list(csv.reader(f))
+        header, body = rows[0], rows[1:]
+        # Python's float() of Rust's shortest round-trip text is the written double.
+        expected = np.array([[float(x) for x in r] for r in body]).T
+        t = pq.read_table(tmp_path / "pq" / "series" / f"{case_id}.parquet")
+        assert t.column_names == header
+        assert t.num_rows == len(body) > 10
+        for k, name in enumerate(header):
+            got = t.column(name).to_numpy()
+            assert got.dtype == np.float64
+            assert np.array_equal(got.view(np.uint64), expected[k].view(np.uint64)), name
+        # read_series gives the same frame from either file.
+        a, b = rs.read_series(tmp_path / "csv", case_id), rs.read_series(tmp_path / "pq", case_id)
+        assert list(a.columns) == header and a.equals(b)
+    # A Dask worker writes the same Parquet files.
+    client = request.getfixturevalue("client")
+    rs.run(paths["Parquet"], tmp_path / "dask", backend=client, progress=False)
+    for case_id in ids:
+        mine = (tmp_path / "dask" / "series" / f"{case_id}.parquet").read_bytes()
+        assert mine == (tmp_path / "pq" / "series" / f"{case_id}.parquet").read_bytes()

@@ -711,6 +711,23 @@ pub fn build_train(
     models: &[&Model],
     engines: Vec<Box<dyn Equations>>,
 ) -> Result<TrainSetup, RunError> {
+    build_train_with(
+        train,
+        models,
+        engines,
+        &crate::forces::ContactTableCache::new(),
+    )
+}
+
+/// [`build_train`] taking the wheel–rail contact tables from `tables` and
+/// leaving the ones it builds there (the vehicles of the train share them,
+/// and so do the trains given the same cache: the cases of a study).
+pub fn build_train_with(
+    train: &TrainScenario,
+    models: &[&Model],
+    engines: Vec<Box<dyn Equations>>,
+    tables: &crate::forces::ContactTableCache,
+) -> Result<TrainSetup, RunError> {
     let setup = |message: String| RunError::Setup {
         file: train.source.clone(),
         message,
@@ -731,13 +748,12 @@ pub fn build_train(
     let (mut q0, mut v0, mut breakpoints) = (Vec::new(), Vec::new(), Vec::new());
     let mut arc = None;
     // Contact tables built for one vehicle serve the others.
-    let tables = crate::forces::ContactTableCache::new();
     for (k, (model, engine)) in models.iter().zip(engines).enumerate() {
         let name = &train.vehicles[k].name;
         let scenario = train.vehicle_scenario(k, model);
         let state = scenario_state(&scenario, model)?;
         let (equations, times, binding) =
-            drive_track_frames(&scenario, model, &state.params, engine, &tables)?;
+            drive_track_frames(&scenario, model, &state.params, engine, tables)?;
         let mut system = ModelSystem::new(model, equations, state.params)?;
         match binding {
             Some(b) => {
@@ -834,7 +850,24 @@ pub fn run_train_into(
     models: &[&Model],
     engines: Vec<Box<dyn Equations>>,
     sink: &mut dyn OutputSink,
+    progress: impl FnMut(f64),
+) -> Result<RunSummary, RunError> {
+    let tables = crate::forces::ContactTableCache::new();
+    run_train_with(train, models, engines, sink, progress, &tables)
+}
+
+/// [`run_train_into`] taking the wheel–rail contact tables from `tables`
+/// and leaving the ones it builds there, as
+/// [`run_scenario_with`](crate::run::run_scenario_with) does for one
+/// vehicle: the runs of a study of one train build each table once (a table
+/// is the same whoever builds it, so the results are too).
+pub fn run_train_with(
+    train: &TrainScenario,
+    models: &[&Model],
+    engines: Vec<Box<dyn Equations>>,
+    sink: &mut dyn OutputSink,
     mut progress: impl FnMut(f64),
+    tables: &crate::forces::ContactTableCache,
 ) -> Result<RunSummary, RunError> {
     let mut names: Vec<String> = Vec::new();
     for e in &engines {
@@ -849,7 +882,7 @@ pub fn run_train_into(
         breakpoints,
         columns,
         ..
-    } = build_train(train, models, engines)?;
+    } = build_train_with(train, models, engines, tables)?;
     let runner = Runner {
         integrator: &train.integrator,
         breakpoints: &breakpoints,

@@ -6,7 +6,7 @@ use crate::reduce::{CaseReducer, Cell};
 use crate::{Case, StudyError};
 use railmbs_models::Model;
 use railmbs_runtime::forces::ContactTableCache;
-use railmbs_runtime::run::{CsvFile, Interruptible, OutputSink, RunError, run_scenario_with};
+use railmbs_runtime::run::{Interruptible, OutputSink, RunError, run_scenario_with};
 use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -47,7 +47,8 @@ pub struct StudyEngine {
 /// Options of one case's run.
 #[derive(Debug, Clone, Default)]
 pub struct CaseOptions {
-    /// Write the case's output rows as `<case id>.csv` in this folder.
+    /// Write the case's output rows as `<case id>.csv` (or `.parquet`, the
+    /// study's [`series_format`](Study::series_format)) in this folder.
     pub series_dir: Option<PathBuf>,
     /// Stop the run at its next output row when set (Ctrl-C).
     pub stop: Option<Arc<AtomicBool>>,
@@ -217,8 +218,8 @@ impl StudyEngine {
         self.plugins.iter().map(Plugin::path).collect()
     }
 
-    /// Wheel–rail contact tables built so far (shared by the cases of a
-    /// single-vehicle study; a train's runs build their own).
+    /// Wheel–rail contact tables built so far (shared by the cases of the
+    /// study, and by the vehicles of a train).
     pub fn contact_tables(&self) -> usize {
         self.tables.len()
     }
@@ -287,8 +288,8 @@ impl StudyEngine {
         let mut series = options
             .series_dir
             .as_ref()
-            .map(|d| CsvFile::new(d.join(format!("{}.csv", case.id))));
-        let inner = series.as_mut().map(|s| s as &mut dyn OutputSink);
+            .map(|d| study.series_format.sink(d, &case.id));
+        let inner = series.as_mut().map(|s| s.as_mut() as &mut dyn OutputSink);
         let mut reducer = CaseReducer::new(&study.reductions, inner);
         let flag = options.stop.clone().unwrap_or_default();
         let run = {
@@ -316,7 +317,14 @@ impl StudyEngine {
                         .iter()
                         .map(|&k| self.equations(study, k))
                         .collect();
-                    railmbs_runtime::train::run_train_into(t, &models, engines, &mut sink, |_| {})
+                    railmbs_runtime::train::run_train_with(
+                        t,
+                        &models,
+                        engines,
+                        &mut sink,
+                        |_| {},
+                        &self.tables,
+                    )
                 }
             }
         };

@@ -2,6 +2,7 @@
 
 use crate::cases::{self, Case};
 use crate::reduce::{Reduction, ReductionKind, Window};
+use crate::series::SeriesFormat;
 use railmbs_models::syntax::{Locator, OrderedMap, Value, ron_error};
 use railmbs_models::{AnyScenario, Model, ModelError, ModelErrors, Scenario, TrainScenario};
 use serde::Deserialize;
@@ -42,6 +43,16 @@ struct RawStudy {
     reductions: Vec<RawReduction>,
     #[serde(default)]
     time_series: bool,
+    /// Written bare (`series_format: Parquet`); `None` when not given.
+    #[serde(default, deserialize_with = "given")]
+    series_format: Option<SeriesFormat>,
+}
+
+/// A value written bare for an `Option` field (`Some` when it is there).
+fn given<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(
+    d: D,
+) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
 }
 
 #[derive(Debug, Deserialize)]
@@ -184,8 +195,11 @@ pub struct Study {
     pub cases: Vec<Case>,
     /// The reductions of every case.
     pub reductions: Vec<Reduction>,
-    /// Whether each case's output is written as `series/<case id>.csv`.
+    /// Whether each case's output is written as `series/<case id>.csv`
+    /// (or `.parquet`, after `series_format`).
     pub time_series: bool,
+    /// The file format of the time series.
+    pub series_format: SeriesFormat,
 }
 
 /// Errors of a study file, collected, each at the position of `key` (or of
@@ -347,6 +361,7 @@ impl Study {
             cases: Vec::new(),
             reductions,
             time_series: raw.time_series,
+            series_format: raw.series_format.unwrap_or_default(),
         };
         if p.errors.is_empty() {
             study.cases = cases::resolve(&study, rows, &mut p);

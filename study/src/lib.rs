@@ -49,6 +49,10 @@
 //!     ],
 //!     // Optional: write each case's output as series/<case id>.csv.
 //!     time_series: false,
+//!     // Optional: the format of those files, Csv (default) or Parquet
+//!     // (series/<case id>.parquet: one DOUBLE column per output column,
+//!     // the values bit for bit).
+//!     series_format: Csv,
 //! )
 //! ```
 //!
@@ -160,6 +164,7 @@ mod engine;
 mod format;
 mod pool;
 mod reduce;
+mod series;
 mod store;
 
 pub use cases::{Case, Overrides};
@@ -167,6 +172,7 @@ pub use engine::{CaseOptions, CaseResult, CaseStatus, PluginBuilds, StudyEngine}
 pub use format::{CaseSource, EngineKind, Study, StudyScenario};
 pub use pool::{PoolOptions, PoolSummary, run_local, threads};
 pub use reduce::{Cell, Reduction, ReductionKind, Stat, Window, reduce_table};
+pub use series::{ParquetFile, SeriesFormat};
 pub use store::{ResultStore, case_file, collect_case_files, read_case_file, write_case_file};
 
 /// Errors of a study as a whole (a case's own failure is a [`CaseResult`]).

@@ -28,6 +28,13 @@ fn bad_study_files_get_located_errors() {
         ),
         (
             format!(
+                "Study(\n  scenario: \"{s}\",\n  cases: Grid({{ \"k\": [1] }}),\n  time_series: true, series_format: Arrow,\n)"
+            ),
+            ":4:",
+            "Arrow",
+        ),
+        (
+            format!(
                 "Study(\n  scenario: \"{s}\",\n  engine: Fast,\n  cases: Grid({{ \"k\": [1] }}),\n)"
             ),
             ":3:",

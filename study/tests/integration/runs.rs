@@ -357,4 +357,100 @@ fn a_train_study_builds_one_plugin_for_its_identical_vehicles_and_matches_a_trai
         max
     );
     assert_eq!(number(&study, &record, "assessment.wheelsets"), 12.0);
+
+    // The train's cases share the engine's contact tables: the 12 wheelsets
+    // (one profile pair on one track) built one table in the first case, and
+    // the next cases build none (the cache holds each table it built once)
+    // and give the same numbers as a run that built its own.
+    assert_eq!(engine.contact_tables(), 1);
+    let other = engine
+        .run_case(&study, &study.cases()[0], &CaseOptions::default())
+        .unwrap();
+    assert_eq!(other.status, CaseStatus::Ok, "{:?}", other.error);
+    let again = engine
+        .run_case(&study, &study.cases()[1], &CaseOptions::default())
+        .unwrap();
+    assert_eq!(engine.contact_tables(), 1, "no table built again");
+    assert_eq!(again.values, result.values);
+}
+
+/// The values of a CSV time series, by column, parsed (Rust's shortest
+/// round-trip text: parsing gives back the written `f64` exactly).
+fn csv_columns(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let mut cols = vec![Vec::new(); header.len()];
+    for rec in r.records() {
+        for (c, x) in cols.iter_mut().zip(rec.unwrap().iter()) {
+            c.push(x.parse::<f64>().unwrap());
+        }
+    }
+    (header, cols)
+}
+
+#[test]
+fn a_parquet_time_series_read_back_equals_the_csv_time_series_bit_for_bit() {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+    let dir = tempfile::tempdir().unwrap();
+    // 90 s at 0.01 s: 9001 rows, more than one row group (8192 rows).
+    let study_of = |sub: &str, format: &str| {
+        let d = dir.path().join(sub);
+        std::fs::create_dir_all(&d).unwrap();
+        load(
+            &d,
+            &format!(
+                r#"Study(scenario: "{}", engine: Numeric, end_time: Some(90.0),
+                         cases: List([{{ "zeta": 0.05 }}]), reductions: [Max(column: "z")],
+                         time_series: true, series_format: {format})"#,
+                scenario("spring_mass.ron")
+            ),
+        )
+    };
+    let (csv_study, pq_study) = (study_of("csv", "Csv"), study_of("pq", "Parquet"));
+    let run = |study: &Study| {
+        let engine = StudyEngine::prepare(study, None).unwrap();
+        let options = CaseOptions {
+            series_dir: Some(study.source.parent().unwrap().join("series")),
+            stop: None,
+        };
+        let case = &study.cases()[0];
+        let r = engine.run_case(study, case, &options).unwrap();
+        assert_eq!(r.status, CaseStatus::Ok, "{:?}", r.error);
+        options.series_dir.unwrap()
+    };
+    let id = &csv_study.cases()[0].id;
+    assert_eq!(id, &pq_study.cases()[0].id, "the format is not an input");
+    let (header, cols) = csv_columns(&run(&csv_study).join(format!("{id}.csv")));
+    assert_eq!(cols[0].len(), 9001);
+    let pq_dir = run(&pq_study);
+    assert!(!pq_dir.join(format!("{id}.parquet.partial")).exists());
+    let reader = SerializedFileReader::new(
+        std::fs::File::open(pq_dir.join(format!("{id}.parquet"))).unwrap(),
+    )
+    .unwrap();
+    let meta = reader.metadata();
+    assert_eq!(meta.num_row_groups(), 2);
+    assert_eq!(meta.file_metadata().num_rows(), 9001);
+    let names: Vec<String> = meta
+        .file_metadata()
+        .schema_descr()
+        .columns()
+        .iter()
+        .map(|c| c.name().to_string())
+        .collect();
+    assert_eq!(names, header);
+    let mut got = vec![Vec::new(); header.len()];
+    for row in reader.get_row_iter(None).unwrap() {
+        for (k, (_, field)) in row.unwrap().get_column_iter().enumerate() {
+            let Field::Double(x) = field else {
+                panic!("column {k} is not DOUBLE: {field:?}")
+            };
+            got[k].push(*x);
+        }
+    }
+    for (k, (a, b)) in got.iter().zip(&cols).enumerate() {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(a), bits(b), "column {}", header[k]);
+    }
 }

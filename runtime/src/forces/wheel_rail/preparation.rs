@@ -42,8 +42,17 @@ pub struct TrackBinding {
 /// share them, and so do the runs given the same cache
 /// ([`run_scenario_with`](crate::run::run_scenario_with): the cases of a
 /// study, whose model and track are the same). A clone shares the tables.
+///
+/// Each table has its own slot: a run that needs a table another thread is
+/// building waits for it (and then shares it), while tables of other keys
+/// (a study over the flange back distance, say) are built at the same time
+/// on other threads.
 #[derive(Debug, Clone, Default)]
-pub struct ContactTableCache(Arc<Mutex<HashMap<TableKey, Arc<PreparedContact>>>>);
+pub struct ContactTableCache(Arc<Mutex<HashMap<TableKey, TableSlot>>>);
+
+/// The slot of one table: empty until its first builder has built it (a
+/// build that failed leaves it empty for the next run to try again).
+type TableSlot = Arc<Mutex<Option<Arc<PreparedContact>>>>;
 
 impl ContactTableCache {
     /// An empty cache.
@@ -51,9 +60,13 @@ impl ContactTableCache {
         Self::default()
     }
 
-    /// Number of tables built into it.
+    /// Number of tables built into it (waits for the builds under way).
     pub fn len(&self) -> usize {
-        self.0.lock().map_or(0, |t| t.len())
+        let Ok(slots) = self.0.lock() else { return 0 };
+        slots
+            .values()
+            .filter(|slot| slot.lock().is_ok_and(|t| t.is_some()))
+            .count()
     }
 
     /// Whether no table was built into it.
@@ -171,12 +184,20 @@ impl WheelRailContact {
             },
         };
         let key = inputs.key();
-        let mut tables = binding
+        // The map is locked only to find (or make) the table's slot; the
+        // slot stays locked while its table is built.
+        let slot = binding
             .tables
             .0
             .lock()
+            .map_err(|_| self.err("contact table cache poisoned"))?
+            .entry(key.clone())
+            .or_default()
+            .clone();
+        let mut slot = slot
+            .lock()
             .map_err(|_| self.err("contact table cache poisoned"))?;
-        if let Some(p) = tables.get(&key) {
+        if let Some(p) = slot.as_ref() {
             return Ok(p.clone());
         }
         // The profiles were read and validated when the model was loaded;
@@ -219,7 +240,7 @@ impl WheelRailContact {
             table,
             flange_angle,
         });
-        tables.insert(key, prepared.clone());
+        *slot = Some(prepared.clone());
         Ok(prepared)
     }
 
