@@ -174,26 +174,83 @@ mod tests {
 pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
     let n = m.nrows();
     let data = m.as_mut_slice();
-    for j in 0..n {
-        let (left, right) = data.split_at_mut(j * n);
-        let col_j = &mut right[..n];
+    // Small orders get their own copy of the kernel with n a constant, which
+    // the compiler unrolls (the loops of a 10×10 factorization are a few
+    // elements long: loop overhead would cost more than the arithmetic).
+    // Same operations in the same order at every size.
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => cholesky_small::<$k>(data),)*
+                _ => cholesky_kernel(data, n),
+            }
+        };
+    }
+    sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`cholesky_kernel`] for a constant order `N` (loops of constant length,
+/// unrolled by the compiler). Each entry of L is accumulated in a register,
+/// `a_ij − l_i0 l_j0 − l_i1 l_j1 − …` with the terms of zero `l_jk` skipped,
+/// which are the operations of [`cholesky_kernel`] in the same order: the
+/// factor is the same bit for bit.
+fn cholesky_small<const N: usize>(data: &mut [f64]) -> bool {
+    let Ok(a) = <&mut [[f64; N]; N]>::try_from(data.as_chunks_mut::<N>().0) else {
+        return false;
+    };
+    for j in 0..N {
+        let mut d = a[j][j];
         for k in 0..j {
-            let col_k = &left[k * n..(k + 1) * n];
-            let ljk = col_k[j];
+            let ljk = a[k][j];
             if ljk != 0.0 {
-                for i in j..n {
-                    col_j[i] -= col_k[i] * ljk;
-                }
+                d -= ljk * ljk;
             }
         }
-        let d = col_j[j];
         if d.is_nan() || d <= 0.0 || d.is_infinite() {
             return false;
         }
         let ljj = d.sqrt();
-        col_j[j] = ljj;
+        a[j][j] = ljj;
         let inv = 1.0 / ljj;
-        for x in &mut col_j[j + 1..] {
+        for i in j + 1..N {
+            let mut s = a[j][i];
+            for k in 0..j {
+                let ljk = a[k][j];
+                if ljk != 0.0 {
+                    s -= a[k][i] * ljk;
+                }
+            }
+            a[j][i] = s * inv;
+        }
+    }
+    true
+}
+
+/// The factorization of [`cholesky_in_place`] on the column-major data of
+/// an `n × n` matrix.
+#[inline(always)]
+fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let (left, right) = data.split_at_mut(j * n);
+        let col_j = &mut right[j..n];
+        // Column j of L from the columns before it (rows j..n only; the
+        // slices carry their bounds, so the inner loop has no index checks).
+        for col_k in left.chunks_exact(n) {
+            let ljk = col_k[j];
+            if ljk != 0.0 {
+                for (c, l) in col_j.iter_mut().zip(&col_k[j..]) {
+                    *c -= l * ljk;
+                }
+            }
+        }
+        let d = col_j[0];
+        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+            return false;
+        }
+        let ljj = d.sqrt();
+        col_j[0] = ljj;
+        let inv = 1.0 / ljj;
+        for x in &mut col_j[1..] {
             *x *= inv;
         }
     }
@@ -203,26 +260,72 @@ pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky_in_place`].
 pub(crate) fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     let n = l.nrows();
+    if n == 0 {
+        return;
+    }
     let data = l.as_slice();
-    // L y = b
-    for j in 0..n {
-        let col = &data[j * n..(j + 1) * n];
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => cholesky_solve_small::<$k>(data, &mut b[..$k]),)*
+                _ => cholesky_solve_kernel(data, &mut b[..n], n),
+            }
+        };
+    }
+    sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`cholesky_solve_kernel`] for a constant order `N` (loops of constant
+/// length, unrolled; the same operations in the same order).
+fn cholesky_solve_small<const N: usize>(data: &[f64], b: &mut [f64]) {
+    let (cols, _) = data.as_chunks::<N>();
+    for j in 0..N {
+        let col = &cols[j];
         let yj = b[j] / col[j];
         b[j] = yj;
         if yj != 0.0 {
-            for i in j + 1..n {
-                b[i] -= col[i] * yj;
+            for i in 0..N {
+                if i > j {
+                    b[i] -= col[i] * yj;
+                }
             }
         }
     }
-    // Lᵀ x = y
-    for j in (0..n).rev() {
-        let col = &data[j * n..(j + 1) * n];
+    for j in (0..N).rev() {
+        let col = &cols[j];
         let mut s = b[j];
-        for i in j + 1..n {
-            s -= col[i] * b[i];
+        for i in 0..N {
+            if i > j {
+                s -= col[i] * b[i];
+            }
         }
         b[j] = s / col[j];
+    }
+}
+
+/// The solve of [`cholesky_solve`] with the factor's column-major data
+/// (`n × n`) and the right-hand side `b` (`n`).
+#[inline(always)]
+fn cholesky_solve_kernel(data: &[f64], b: &mut [f64], n: usize) {
+    // L y = b (column oriented: y_j, then subtract it from the rows below).
+    for (j, col) in data.chunks_exact(n).enumerate() {
+        let (head, tail) = b.split_at_mut(j + 1);
+        let yj = head[j] / col[j];
+        head[j] = yj;
+        if yj != 0.0 {
+            for (x, c) in tail.iter_mut().zip(&col[j + 1..]) {
+                *x -= c * yj;
+            }
+        }
+    }
+    // Lᵀ x = y (row j of Lᵀ is column j of L: a dot product down the column).
+    for (j, col) in data.chunks_exact(n).enumerate().rev() {
+        let (head, tail) = b.split_at_mut(j + 1);
+        let mut s = head[j];
+        for (c, x) in col[j + 1..].iter().zip(tail.iter()) {
+            s -= c * x;
+        }
+        head[j] = s / col[j];
     }
 }
 
@@ -255,7 +358,43 @@ mod cholesky_tests {
         }
         let mut indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
         assert!(!cholesky_in_place(&mut indefinite));
+        let mut indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(!cholesky_kernel(indefinite.as_mut_slice(), 2));
+        assert!(!cholesky_in_place(&mut indefinite));
         let mut nan = DMatrix::from_row_slice(1, 1, &[f64::NAN]);
+        assert!(!cholesky_kernel(nan.as_mut_slice(), 1));
         assert!(!cholesky_in_place(&mut nan));
+    }
+
+    #[test]
+    fn sized_kernels_round_exactly_like_the_general_ones() {
+        // The unrolled kernels of orders ≤ 16 must give the general kernel's
+        // factor and solution bit for bit (the scenario outputs must not
+        // depend on which one ran).
+        for n in 1usize..=16 {
+            let b = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 11) % 13) as f64 / 7.0 - 0.8);
+            let a = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
+            let mut small = a.clone();
+            let mut general = a.clone();
+            assert!(cholesky_in_place(&mut small));
+            assert!(cholesky_kernel(general.as_mut_slice(), n));
+            let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.91).cos()).collect();
+            let mut xs = rhs.clone();
+            let mut xg = rhs.clone();
+            cholesky_solve(&small, &mut xs);
+            cholesky_solve_kernel(general.as_slice(), &mut xg, n);
+            for j in 0..n {
+                for i in j..n {
+                    assert_eq!(
+                        small[(i, j)].to_bits(),
+                        general[(i, j)].to_bits(),
+                        "n = {n}"
+                    );
+                }
+            }
+            for (u, w) in xs.iter().zip(&xg) {
+                assert_eq!(u.to_bits(), w.to_bits(), "n = {n}");
+            }
+        }
     }
 }
