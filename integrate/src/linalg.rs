@@ -65,12 +65,13 @@ impl DenseLu {
         }
         let tiny = (n.max(1) as f64) * f64::EPSILON * amax;
         for k in 0..n {
+            // Pivot: the first entry of largest magnitude in column k, rows k..n.
+            let col_k = &a[k * n..(k + 1) * n];
             let mut p = k;
-            let mut pmax = a[k + k * n].abs();
-            for i in k + 1..n {
-                let v = a[i + k * n].abs();
-                if v > pmax {
-                    pmax = v;
+            let mut pmax = col_k[k].abs();
+            for (i, v) in col_k.iter().enumerate().skip(k + 1) {
+                if v.abs() > pmax {
+                    pmax = v.abs();
                     p = i;
                 }
             }
@@ -79,22 +80,22 @@ impl DenseLu {
                 return Err(SingularPivot { column: k });
             }
             if p != k {
-                for j in 0..n {
-                    a.swap(k + j * n, p + j * n);
+                for col in a.chunks_exact_mut(n) {
+                    col.swap(k, p);
                 }
             }
-            let inv = 1.0 / a[k + k * n];
-            for i in k + 1..n {
-                a[i + k * n] *= inv;
+            let (left, right) = a.split_at_mut((k + 1) * n);
+            let col_k = &mut left[k * n..];
+            let inv = 1.0 / col_k[k];
+            for x in &mut col_k[k + 1..] {
+                *x *= inv;
             }
-            for j in k + 1..n {
-                let akj = a[k + j * n];
+            let lcol = &col_k[k + 1..];
+            for col in right.chunks_exact_mut(n) {
+                let akj = col[k];
                 if akj != 0.0 {
-                    // a[k+1.., j] -= l[k+1.., k] * a[k, j]; split borrows by column.
-                    let (left, right) = a.split_at_mut(j * n);
-                    let lcol = &left[k * n + k + 1..k * n + n];
-                    let col = &mut right[k + 1..n];
-                    for (c, l) in col.iter_mut().zip(lcol) {
+                    // a[k+1.., j] -= l[k+1.., k] * a[k, j]
+                    for (c, l) in col[k + 1..].iter_mut().zip(lcol) {
                         *c -= l * akj;
                     }
                 }
@@ -116,22 +117,27 @@ impl DenseLu {
                 x.swap(k, p);
             }
         }
+        if n == 0 {
+            return;
+        }
         // Forward substitution with unit lower triangle (column oriented).
-        for j in 0..n {
-            let xj = x[j];
+        for (j, col) in a.chunks_exact(n).enumerate() {
+            let (head, tail) = x.split_at_mut(j + 1);
+            let xj = head[j];
             if xj != 0.0 {
-                for i in j + 1..n {
-                    x[i] -= a[i + j * n] * xj;
+                for (xi, l) in tail.iter_mut().zip(&col[j + 1..]) {
+                    *xi -= l * xj;
                 }
             }
         }
         // Back substitution with U (column oriented).
-        for j in (0..n).rev() {
-            x[j] /= a[j + j * n];
-            let xj = x[j];
+        for (j, col) in a.chunks_exact(n).enumerate().rev() {
+            let (head, _) = x.split_at_mut(j + 1);
+            head[j] /= col[j];
+            let xj = head[j];
             if xj != 0.0 {
-                for i in 0..j {
-                    x[i] -= a[i + j * n] * xj;
+                for (xi, u) in head[..j].iter_mut().zip(col) {
+                    *xi -= u * xj;
                 }
             }
         }
