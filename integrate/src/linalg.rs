@@ -1,4 +1,5 @@
-//! Small dense linear algebra used inside the step loop: an LU factorization
+//! Small dense linear algebra used inside the step loop (public so that
+//! `umsim bench` times the integrators' own kernels): an LU factorization
 //! with partial pivoting that works in place on a preallocated matrix, so the
 //! integrators never allocate while stepping.
 
@@ -9,7 +10,7 @@ use nalgebra::{DMatrix, DVector};
 /// triangle holds U, `piv[k]` is the row swapped with row k at elimination
 /// step k.
 #[derive(Debug, Clone)]
-pub(crate) struct DenseLu {
+pub struct DenseLu {
     lu: DMatrix<f64>,
     piv: Vec<usize>,
     valid: bool,
@@ -18,13 +19,14 @@ pub(crate) struct DenseLu {
 /// Why a factorization failed: the elimination column with a (relatively)
 /// zero or non-finite pivot.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct SingularPivot {
+pub struct SingularPivot {
+    /// The elimination column (0-based).
     pub column: usize,
 }
 
 impl DenseLu {
     /// Workspace for an `n × n` system.
-    pub(crate) fn new(n: usize) -> Self {
+    pub fn new(n: usize) -> Self {
         Self {
             lu: DMatrix::zeros(n, n),
             piv: vec![0; n],
@@ -33,7 +35,7 @@ impl DenseLu {
     }
 
     /// Order of the system.
-    pub(crate) fn dim(&self) -> usize {
+    pub fn dim(&self) -> usize {
         self.piv.len()
     }
 
@@ -44,7 +46,7 @@ impl DenseLu {
     }
 
     /// The matrix to be factorized; fill it, then call [`DenseLu::factorize`].
-    pub(crate) fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
+    pub fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
         self.valid = false;
         &mut self.lu
     }
@@ -52,7 +54,7 @@ impl DenseLu {
     /// Factorize the matrix filled through [`DenseLu::matrix_mut`] in place.
     /// A pivot that is non-finite or below `n·ε·max|a_ij|` is reported as
     /// singular (the matrix is then numerically rank-deficient).
-    pub(crate) fn factorize(&mut self) -> Result<(), SingularPivot> {
+    pub fn factorize(&mut self) -> Result<(), SingularPivot> {
         let n = self.dim();
         self.valid = false;
         let a = self.lu.as_mut_slice(); // column-major: a[i + j n]
@@ -106,7 +108,7 @@ impl DenseLu {
     }
 
     /// Solve `A x = b` in place (b becomes x) with the stored factorization.
-    pub(crate) fn solve_in_place(&self, b: &mut DVector<f64>) {
+    pub fn solve_in_place(&self, b: &mut DVector<f64>) {
         debug_assert!(self.valid, "solve with an invalid LU factorization");
         let n = self.dim();
         let a = self.lu.as_slice();
@@ -177,7 +179,7 @@ mod tests {
 /// Column-oriented ("left-looking") so that every inner loop runs down a
 /// contiguous column. Returns `false` if a pivot is not positive (M not
 /// positive definite, or not finite).
-pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
+pub fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
     let n = m.nrows();
     let data = m.as_mut_slice();
     // Small orders get their own copy of the kernel with n a constant, which
@@ -264,7 +266,7 @@ fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
 }
 
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky_in_place`].
-pub(crate) fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
+pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     let n = l.nrows();
     if n == 0 {
         return;
