@@ -208,8 +208,8 @@ fn cholesky_small<const N: usize>(data: &mut [f64]) -> bool {
     };
     for j in 0..N {
         let mut d = a[j][j];
-        for k in 0..j {
-            let ljk = a[k][j];
+        for col_k in &a[..j] {
+            let ljk = col_k[j];
             if ljk != 0.0 {
                 d -= ljk * ljk;
             }
@@ -222,10 +222,10 @@ fn cholesky_small<const N: usize>(data: &mut [f64]) -> bool {
         let inv = 1.0 / ljj;
         for i in j + 1..N {
             let mut s = a[j][i];
-            for k in 0..j {
-                let ljk = a[k][j];
+            for col_k in &a[..j] {
+                let ljk = col_k[j];
                 if ljk != 0.0 {
-                    s -= a[k][i] * ljk;
+                    s -= col_k[i] * ljk;
                 }
             }
             a[j][i] = s * inv;
