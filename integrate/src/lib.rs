@@ -49,7 +49,7 @@
 
 use nalgebra::DVector;
 
-mod linalg;
+pub mod linalg;
 pub mod park;
 pub mod rk4;
 pub mod system;

@@ -1,4 +1,5 @@
-//! Small dense linear algebra used inside the step loop: an LU factorization
+//! Small dense linear algebra used inside the step loop (public so that
+//! `umsim bench` times the integrators' own kernels): an LU factorization
 //! with partial pivoting that works in place on a preallocated matrix, so the
 //! integrators never allocate while stepping.
 
@@ -9,7 +10,7 @@ use nalgebra::{DMatrix, DVector};
 /// triangle holds U, `piv[k]` is the row swapped with row k at elimination
 /// step k.
 #[derive(Debug, Clone)]
-pub(crate) struct DenseLu {
+pub struct DenseLu {
     lu: DMatrix<f64>,
     piv: Vec<usize>,
     valid: bool,
@@ -18,13 +19,14 @@ pub(crate) struct DenseLu {
 /// Why a factorization failed: the elimination column with a (relatively)
 /// zero or non-finite pivot.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct SingularPivot {
+pub struct SingularPivot {
+    /// The elimination column (0-based).
     pub column: usize,
 }
 
 impl DenseLu {
     /// Workspace for an `n × n` system.
-    pub(crate) fn new(n: usize) -> Self {
+    pub fn new(n: usize) -> Self {
         Self {
             lu: DMatrix::zeros(n, n),
             piv: vec![0; n],
@@ -33,7 +35,7 @@ impl DenseLu {
     }
 
     /// Order of the system.
-    pub(crate) fn dim(&self) -> usize {
+    pub fn dim(&self) -> usize {
         self.piv.len()
     }
 
@@ -44,7 +46,7 @@ impl DenseLu {
     }
 
     /// The matrix to be factorized; fill it, then call [`DenseLu::factorize`].
-    pub(crate) fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
+    pub fn matrix_mut(&mut self) -> &mut DMatrix<f64> {
         self.valid = false;
         &mut self.lu
     }
@@ -52,7 +54,7 @@ impl DenseLu {
     /// Factorize the matrix filled through [`DenseLu::matrix_mut`] in place.
     /// A pivot that is non-finite or below `n·ε·max|a_ij|` is reported as
     /// singular (the matrix is then numerically rank-deficient).
-    pub(crate) fn factorize(&mut self) -> Result<(), SingularPivot> {
+    pub fn factorize(&mut self) -> Result<(), SingularPivot> {
         let n = self.dim();
         self.valid = false;
         let a = self.lu.as_mut_slice(); // column-major: a[i + j n]
@@ -65,12 +67,13 @@ impl DenseLu {
         }
         let tiny = (n.max(1) as f64) * f64::EPSILON * amax;
         for k in 0..n {
+            // Pivot: the first entry of largest magnitude in column k, rows k..n.
+            let col_k = &a[k * n..(k + 1) * n];
             let mut p = k;
-            let mut pmax = a[k + k * n].abs();
-            for i in k + 1..n {
-                let v = a[i + k * n].abs();
-                if v > pmax {
-                    pmax = v;
+            let mut pmax = col_k[k].abs();
+            for (i, v) in col_k.iter().enumerate().skip(k + 1) {
+                if v.abs() > pmax {
+                    pmax = v.abs();
                     p = i;
                 }
             }
@@ -79,22 +82,22 @@ impl DenseLu {
                 return Err(SingularPivot { column: k });
             }
             if p != k {
-                for j in 0..n {
-                    a.swap(k + j * n, p + j * n);
+                for col in a.chunks_exact_mut(n) {
+                    col.swap(k, p);
                 }
             }
-            let inv = 1.0 / a[k + k * n];
-            for i in k + 1..n {
-                a[i + k * n] *= inv;
+            let (left, right) = a.split_at_mut((k + 1) * n);
+            let col_k = &mut left[k * n..];
+            let inv = 1.0 / col_k[k];
+            for x in &mut col_k[k + 1..] {
+                *x *= inv;
             }
-            for j in k + 1..n {
-                let akj = a[k + j * n];
+            let lcol = &col_k[k + 1..];
+            for col in right.chunks_exact_mut(n) {
+                let akj = col[k];
                 if akj != 0.0 {
-                    // a[k+1.., j] -= l[k+1.., k] * a[k, j]; split borrows by column.
-                    let (left, right) = a.split_at_mut(j * n);
-                    let lcol = &left[k * n + k + 1..k * n + n];
-                    let col = &mut right[k + 1..n];
-                    for (c, l) in col.iter_mut().zip(lcol) {
+                    // a[k+1.., j] -= l[k+1.., k] * a[k, j]
+                    for (c, l) in col[k + 1..].iter_mut().zip(lcol) {
                         *c -= l * akj;
                     }
                 }
@@ -105,7 +108,7 @@ impl DenseLu {
     }
 
     /// Solve `A x = b` in place (b becomes x) with the stored factorization.
-    pub(crate) fn solve_in_place(&self, b: &mut DVector<f64>) {
+    pub fn solve_in_place(&self, b: &mut DVector<f64>) {
         debug_assert!(self.valid, "solve with an invalid LU factorization");
         let n = self.dim();
         let a = self.lu.as_slice();
@@ -116,22 +119,27 @@ impl DenseLu {
                 x.swap(k, p);
             }
         }
+        if n == 0 {
+            return;
+        }
         // Forward substitution with unit lower triangle (column oriented).
-        for j in 0..n {
-            let xj = x[j];
+        for (j, col) in a.chunks_exact(n).enumerate() {
+            let (head, tail) = x.split_at_mut(j + 1);
+            let xj = head[j];
             if xj != 0.0 {
-                for i in j + 1..n {
-                    x[i] -= a[i + j * n] * xj;
+                for (xi, l) in tail.iter_mut().zip(&col[j + 1..]) {
+                    *xi -= l * xj;
                 }
             }
         }
         // Back substitution with U (column oriented).
-        for j in (0..n).rev() {
-            x[j] /= a[j + j * n];
-            let xj = x[j];
+        for (j, col) in a.chunks_exact(n).enumerate().rev() {
+            let (head, _) = x.split_at_mut(j + 1);
+            head[j] /= col[j];
+            let xj = head[j];
             if xj != 0.0 {
-                for i in 0..j {
-                    x[i] -= a[i + j * n] * xj;
+                for (xi, u) in head[..j].iter_mut().zip(col) {
+                    *xi -= u * xj;
                 }
             }
         }
@@ -171,29 +179,86 @@ mod tests {
 /// Column-oriented ("left-looking") so that every inner loop runs down a
 /// contiguous column. Returns `false` if a pivot is not positive (M not
 /// positive definite, or not finite).
-pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
+pub fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
     let n = m.nrows();
     let data = m.as_mut_slice();
-    for j in 0..n {
-        let (left, right) = data.split_at_mut(j * n);
-        let col_j = &mut right[..n];
-        for k in 0..j {
-            let col_k = &left[k * n..(k + 1) * n];
+    // Small orders get their own copy of the kernel with n a constant, which
+    // the compiler unrolls (the loops of a 10×10 factorization are a few
+    // elements long: loop overhead would cost more than the arithmetic).
+    // Same operations in the same order at every size.
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => cholesky_small::<$k>(data),)*
+                _ => cholesky_kernel(data, n),
+            }
+        };
+    }
+    sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`cholesky_kernel`] for a constant order `N` (loops of constant length,
+/// unrolled by the compiler). Each entry of L is accumulated in a register,
+/// `a_ij − l_i0 l_j0 − l_i1 l_j1 − …` with the terms of zero `l_jk` skipped,
+/// which are the operations of [`cholesky_kernel`] in the same order: the
+/// factor is the same bit for bit.
+fn cholesky_small<const N: usize>(data: &mut [f64]) -> bool {
+    let Ok(a) = <&mut [[f64; N]; N]>::try_from(data.as_chunks_mut::<N>().0) else {
+        return false;
+    };
+    for j in 0..N {
+        let mut d = a[j][j];
+        for col_k in &a[..j] {
             let ljk = col_k[j];
             if ljk != 0.0 {
-                for i in j..n {
-                    col_j[i] -= col_k[i] * ljk;
-                }
+                d -= ljk * ljk;
             }
         }
-        let d = col_j[j];
         if d.is_nan() || d <= 0.0 || d.is_infinite() {
             return false;
         }
         let ljj = d.sqrt();
-        col_j[j] = ljj;
+        a[j][j] = ljj;
         let inv = 1.0 / ljj;
-        for x in &mut col_j[j + 1..] {
+        for i in j + 1..N {
+            let mut s = a[j][i];
+            for col_k in &a[..j] {
+                let ljk = col_k[j];
+                if ljk != 0.0 {
+                    s -= col_k[i] * ljk;
+                }
+            }
+            a[j][i] = s * inv;
+        }
+    }
+    true
+}
+
+/// The factorization of [`cholesky_in_place`] on the column-major data of
+/// an `n × n` matrix.
+#[inline(always)]
+fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let (left, right) = data.split_at_mut(j * n);
+        let col_j = &mut right[j..n];
+        // Column j of L from the columns before it (rows j..n only; the
+        // slices carry their bounds, so the inner loop has no index checks).
+        for col_k in left.chunks_exact(n) {
+            let ljk = col_k[j];
+            if ljk != 0.0 {
+                for (c, l) in col_j.iter_mut().zip(&col_k[j..]) {
+                    *c -= l * ljk;
+                }
+            }
+        }
+        let d = col_j[0];
+        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+            return false;
+        }
+        let ljj = d.sqrt();
+        col_j[0] = ljj;
+        let inv = 1.0 / ljj;
+        for x in &mut col_j[1..] {
             *x *= inv;
         }
     }
@@ -201,28 +266,74 @@ pub(crate) fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
 }
 
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky_in_place`].
-pub(crate) fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
+pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     let n = l.nrows();
+    if n == 0 {
+        return;
+    }
     let data = l.as_slice();
-    // L y = b
-    for j in 0..n {
-        let col = &data[j * n..(j + 1) * n];
+    macro_rules! sized {
+        ($($k:literal)*) => {
+            match n {
+                $($k => cholesky_solve_small::<$k>(data, &mut b[..$k]),)*
+                _ => cholesky_solve_kernel(data, &mut b[..n], n),
+            }
+        };
+    }
+    sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+/// [`cholesky_solve_kernel`] for a constant order `N` (loops of constant
+/// length, unrolled; the same operations in the same order).
+fn cholesky_solve_small<const N: usize>(data: &[f64], b: &mut [f64]) {
+    let (cols, _) = data.as_chunks::<N>();
+    for j in 0..N {
+        let col = &cols[j];
         let yj = b[j] / col[j];
         b[j] = yj;
         if yj != 0.0 {
-            for i in j + 1..n {
-                b[i] -= col[i] * yj;
+            for i in 0..N {
+                if i > j {
+                    b[i] -= col[i] * yj;
+                }
             }
         }
     }
-    // Lᵀ x = y
-    for j in (0..n).rev() {
-        let col = &data[j * n..(j + 1) * n];
+    for j in (0..N).rev() {
+        let col = &cols[j];
         let mut s = b[j];
-        for i in j + 1..n {
-            s -= col[i] * b[i];
+        for i in 0..N {
+            if i > j {
+                s -= col[i] * b[i];
+            }
         }
         b[j] = s / col[j];
+    }
+}
+
+/// The solve of [`cholesky_solve`] with the factor's column-major data
+/// (`n × n`) and the right-hand side `b` (`n`).
+#[inline(always)]
+fn cholesky_solve_kernel(data: &[f64], b: &mut [f64], n: usize) {
+    // L y = b (column oriented: y_j, then subtract it from the rows below).
+    for (j, col) in data.chunks_exact(n).enumerate() {
+        let (head, tail) = b.split_at_mut(j + 1);
+        let yj = head[j] / col[j];
+        head[j] = yj;
+        if yj != 0.0 {
+            for (x, c) in tail.iter_mut().zip(&col[j + 1..]) {
+                *x -= c * yj;
+            }
+        }
+    }
+    // Lᵀ x = y (row j of Lᵀ is column j of L: a dot product down the column).
+    for (j, col) in data.chunks_exact(n).enumerate().rev() {
+        let (head, tail) = b.split_at_mut(j + 1);
+        let mut s = head[j];
+        for (c, x) in col[j + 1..].iter().zip(tail.iter()) {
+            s -= c * x;
+        }
+        head[j] = s / col[j];
     }
 }
 
@@ -255,7 +366,43 @@ mod cholesky_tests {
         }
         let mut indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
         assert!(!cholesky_in_place(&mut indefinite));
+        let mut indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(!cholesky_kernel(indefinite.as_mut_slice(), 2));
+        assert!(!cholesky_in_place(&mut indefinite));
         let mut nan = DMatrix::from_row_slice(1, 1, &[f64::NAN]);
+        assert!(!cholesky_kernel(nan.as_mut_slice(), 1));
         assert!(!cholesky_in_place(&mut nan));
+    }
+
+    #[test]
+    fn sized_kernels_round_exactly_like_the_general_ones() {
+        // The unrolled kernels of orders ≤ 16 must give the general kernel's
+        // factor and solution bit for bit (the scenario outputs must not
+        // depend on which one ran).
+        for n in 1usize..=16 {
+            let b = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 11) % 13) as f64 / 7.0 - 0.8);
+            let a = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
+            let mut small = a.clone();
+            let mut general = a.clone();
+            assert!(cholesky_in_place(&mut small));
+            assert!(cholesky_kernel(general.as_mut_slice(), n));
+            let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.91).cos()).collect();
+            let mut xs = rhs.clone();
+            let mut xg = rhs.clone();
+            cholesky_solve(&small, &mut xs);
+            cholesky_solve_kernel(general.as_slice(), &mut xg, n);
+            for j in 0..n {
+                for i in j..n {
+                    assert_eq!(
+                        small[(i, j)].to_bits(),
+                        general[(i, j)].to_bits(),
+                        "n = {n}"
+                    );
+                }
+            }
+            for (u, w) in xs.iter().zip(&xg) {
+                assert_eq!(u.to_bits(), w.to_bits(), "n = {n}");
+            }
+        }
     }
 }

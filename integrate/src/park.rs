@@ -672,9 +672,14 @@ impl Work {
         let (n, nc) = (self.n, self.nc);
         let b2 = beta * beta;
         let m = self.lu.matrix_mut();
-        for j in 0..n {
-            for i in 0..n {
-                m[(i, j)] = self.mass_j[(i, j)] - beta * self.dfdv[(i, j)] - b2 * self.dfdq[(i, j)];
+        // Column by column on slices (no index checks): m = M − β D − β² C.
+        let mass = self.mass_j.as_slice().chunks_exact(n.max(1));
+        let dv = self.dfdv.as_slice().chunks_exact(n.max(1));
+        let dq = self.dfdq.as_slice().chunks_exact(n.max(1));
+        let cols = m.as_mut_slice().chunks_exact_mut(n + nc);
+        for (((col, mj), dvj), dqj) in cols.zip(mass).zip(dv).zip(dq) {
+            for (((x, &a), &d), &c) in col[..n].iter_mut().zip(mj).zip(dvj).zip(dqj) {
+                *x = a - beta * d - b2 * c;
             }
         }
         for k in 0..nc {

@@ -120,6 +120,9 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
     let states = random_states(&model, &params, args.states);
 
     let numeric_make = || build_engine(&model, Engine::Numeric, None).map_err(|e| e.to_string());
+    let linear_ns = numeric_make()
+        .and_then(|e| super::workload::time_linear_solves(e, &params, &states))
+        .ok();
     let mut numeric = EngineTimes::default();
     match time_engine(&model, &params, &states, &numeric_make) {
         Ok((e, d)) => {
@@ -196,5 +199,6 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
         derive_s,
         compile_s,
         creep: args.creep.clone(),
+        linear_ns,
     })
 }

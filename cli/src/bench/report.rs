@@ -51,6 +51,12 @@ pub struct BenchReport {
     pub compile_s: Option<f64>,
     /// The `--creep` override, if any.
     pub creep: Option<String>,
+    /// The integrators' linear solves on the model's M
+    /// ([`time_linear_solves`](super::workload::time_linear_solves)), ns per
+    /// call: the q̈ solve (Cholesky of M and its solve), Park's LU
+    /// factorization of an n×n iteration matrix and one Newton solve with
+    /// it. `None` for a train (not measured) or when M could not be evaluated.
+    pub linear_ns: Option<[f64; 3]>,
 }
 
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
@@ -100,6 +106,9 @@ impl BenchReport {
             "creep": self.creep,
             "derive_s": self.derive_s,
             "compile_s": self.compile_s,
+            "qdd_solve_ns": self.linear_ns.map(|t| t[0]),
+            "lu_factorization_ns": self.linear_ns.map(|t| t[1]),
+            "lu_solve_ns": self.linear_ns.map(|t| t[2]),
             "numeric_note": self.numeric.note,
             "symbolic_note": self.symbolic.note,
         })
@@ -184,6 +193,13 @@ impl BenchReport {
         ];
         for (label, a, b, c) in rows {
             let _ = writeln!(s, "{label:<28} {a:>14} {b:>14} {c:>18}");
+        }
+        if let Some([chol, factor, solve]) = self.linear_ns {
+            let _ = writeln!(
+                s,
+                "linear algebra (either engine): q̈ solve (Cholesky of M, solve) {chol:.1} ns; \
+                 Park: LU factorization {factor:.1} ns, Newton solve {solve:.1} ns"
+            );
         }
         if self.numeric.dynamics_ns.is_none() && self.numeric.eval_ns.is_some() {
             let _ = writeln!(

@@ -157,5 +157,6 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
         derive_s,
         compile_s,
         creep: args.creep.clone(),
+        linear_ns: None,
     })
 }

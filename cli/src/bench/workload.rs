@@ -78,6 +78,11 @@ impl<'a> MassAndBias<'a> {
         })
     }
 
+    /// M of the last evaluation.
+    pub fn mass(&self) -> &DMatrix<f64> {
+        &self.out.mass
+    }
+
     /// Evaluates at the next state.
     pub fn call(&mut self) -> Result<(), String> {
         let s = &self.states[self.next % self.states.len()];
@@ -176,4 +181,55 @@ pub(crate) fn time_engine(
     let mut dynamics = Dynamics::new(model, make()?, params, states)?;
     let dynamics_ns = time_per_call(|_| dynamics.call())?;
     Ok((eval_ns, Some(dynamics_ns)))
+}
+
+/// The integrators' linear algebra on the model's mass matrices M at
+/// `states` (evaluated once by `equations`), ns per call, in the order
+/// (q̈ solve, LU factorization, LU solve): the Cholesky factorization of M
+/// and its solve (RK4's q̈ per stage, `railmbs_integrate::linalg`), and the
+/// dense LU factorization with partial pivoting and its solve, the kernels
+/// of Park's Newton iterations (the iteration matrix M − βD − β²C has M's
+/// order and pattern without constraints; here it is M itself, so the
+/// pivots differ but not the work).
+pub fn time_linear_solves(
+    equations: Box<dyn Equations>,
+    params: &[f64],
+    states: &[State],
+) -> Result<[f64; 3], String> {
+    use railmbs_runtime::integrate::linalg::{DenseLu, cholesky_in_place, cholesky_solve};
+    let mut eval = MassAndBias::new(equations, params, states)?;
+    let mut masses = Vec::with_capacity(states.len());
+    for _ in states {
+        eval.call()?;
+        masses.push(eval.mass().clone());
+    }
+    let n = masses[0].nrows();
+    let rhs = DVector::from_element(n, 1.0);
+    let mut work = masses[0].clone();
+    let mut x = rhs.clone();
+    let chol = time_per_call(|k| {
+        work.copy_from(&masses[k % masses.len()]);
+        x.copy_from(&rhs);
+        if !cholesky_in_place(&mut work) {
+            return Err("the mass matrix is not positive definite".to_string());
+        }
+        cholesky_solve(&work, x.as_mut_slice());
+        std::hint::black_box(&x);
+        Ok(())
+    })?;
+    let mut lu = DenseLu::new(n);
+    let factor = time_per_call(|k| {
+        lu.matrix_mut().copy_from(&masses[k % masses.len()]);
+        lu.factorize()
+            .map_err(|p| format!("the mass matrix is singular (column {})", p.column))?;
+        std::hint::black_box(&lu);
+        Ok::<(), String>(())
+    })?;
+    let solve = time_per_call(|_| {
+        x.copy_from(&rhs);
+        lu.solve_in_place(&mut x);
+        std::hint::black_box(&x);
+        Ok::<(), String>(())
+    })?;
+    Ok([chol, factor, solve])
 }
