@@ -165,7 +165,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 &mut Discard as &mut dyn OutputSink,
                 |_| {},
             )?;
-            print!("{}", describe_branch(&signals, &points, args.threshold));
+            print!("{}", describe_branch(&signals, &points, args.on));
             if let Some(e) = &summary.error {
                 println!("the run stopped at t = {} s: {e}", summary.t_end);
             }
@@ -264,7 +264,7 @@ pub fn describe_detection(
 }
 
 /// The lowest speed of the diagram where the limit cycle still goes on
-/// (amplitude at least `threshold`) with every faster plateau hunting too:
+/// (amplitude at least `threshold`, the on threshold) with every faster plateau hunting too:
 /// the stable branch's fold lies between it and the next plateau.
 pub fn lowest_hunting(points: &[BranchPoint], threshold: f64) -> Option<(f64, Option<f64>)> {
     let n = points
@@ -301,8 +301,8 @@ pub fn describe_branch(signals: &[String], points: &[BranchPoint], threshold: f6
     let _ = match lowest_hunting(points, threshold) {
         Some((v, Some(below))) => writeln!(
             s,
-            "\nthe limit cycle goes on down to {v:.3} m/s and has died out at {below:.3} m/s: \
-             the nonlinear critical speed lies between"
+            "\nthe limit cycle (amplitude ≥ {threshold} m) goes on down to {v:.3} m/s and has \
+             died out at {below:.3} m/s: the nonlinear critical speed lies between"
         ),
         Some((v, None)) => writeln!(
             s,
