@@ -4,7 +4,8 @@
 //! by their dominant coordinates; the CSV holds the normalized mode
 //! shapes), or with `--speed` the root locus over speed (CSV: one row per
 //! speed and mode) and the linear critical speed, where the least damped
-//! lateral (hunting) mode's damping ratio crosses zero.
+//! lateral (hunting) mode's damping ratio crosses zero; `--plot FILE` draws
+//! that mode's damping ratio and frequency against speed.
 
 use crate::engine::EngineOptions;
 use railmbs_runtime::analysis::modes::Mode;
@@ -27,6 +28,11 @@ pub struct Args {
     /// CSV: the modes with their shapes, or with `--speed` the root locus.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// With `--speed`, a plot (`.svg` or `.png`) of the least damped lateral
+    /// mode's damping ratio and frequency against speed, the linear critical
+    /// speed in the title (its data in a CSV beside it, `FILE.csv`).
+    #[arg(long, value_name = "FILE", requires = "speed")]
+    pub plot: Option<PathBuf>,
     /// Engine and parameters.
     #[command(flatten)]
     pub engine: EngineOptions,
@@ -78,6 +84,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     };
+    if let Some(p) = &args.plot {
+        crate::plot::Format::of(p)?;
+    }
     match &args.speed {
         None => {
             let start = std::time::Instant::now();
@@ -97,6 +106,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             if let Some(path) = &args.output {
                 write_locus(path, &locus)?;
                 println!("root locus written to {}", path.display());
+            }
+            if let Some(plot) = &args.plot {
+                plot_locus(plot, args.output.as_deref(), &locus)?;
             }
         }
     }
@@ -273,5 +285,62 @@ fn write_locus(
         }
     }
     w.flush().map_err(|e| csv_error(path, e))?;
+    Ok(())
+}
+
+/// The root-locus plot: the least damped lateral mode's damping ratio and
+/// frequency against speed (`umsim plot` of a CSV beside the plot, one row
+/// per speed), the linear critical speed in the title.
+fn plot_locus(
+    plot: &std::path::Path,
+    output: Option<&std::path::Path>,
+    locus: &[SpeedModes],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let csv = plot.with_extension("csv");
+    if output == Some(csv.as_path()) {
+        return Err(format!(
+            "--plot {} would write its data over the -o file {}",
+            plot.display(),
+            csv.display()
+        )
+        .into());
+    }
+    let mut w = csv::Writer::from_path(&csv).map_err(|e| csv_error(&csv, e))?;
+    w.write_record(["speed[m/s]", "zeta[-]", "f[Hz]"])
+        .map_err(|e| csv_error(&csv, e))?;
+    for one in locus {
+        if let Some(m) = one.modes.least_damped_lateral() {
+            w.write_record([
+                format!("{:?}", one.speed),
+                format!("{:?}", m.damping_ratio),
+                format!("{:?}", m.frequency),
+            ])
+            .map_err(|e| csv_error(&csv, e))?;
+        }
+    }
+    w.flush().map_err(|e| csv_error(&csv, e))?;
+    let title = match critical_speed(locus) {
+        Some(v) => format!(
+            "least damped lateral mode; linear critical speed {v:.2} m/s ({:.1} km/h): zeta = 0",
+            3.6 * v
+        ),
+        None => "least damped lateral mode; no linear critical speed in this range".into(),
+    };
+    crate::plot::run(&crate::plot::Args {
+        input: csv.clone(),
+        y: vec!["zeta[-]".into(), "f[Hz]".into()],
+        x: "speed[m/s]".into(),
+        from: None,
+        to: None,
+        title: Some(title),
+        width: 1000,
+        height: None,
+        output: plot.to_path_buf(),
+    })?;
+    println!(
+        "root-locus plot written to {} (data {})",
+        plot.display(),
+        csv.display()
+    );
     Ok(())
 }
