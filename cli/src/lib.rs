@@ -1,12 +1,13 @@
 //! # railmbs-cli
 //!
-//! The command-line tools: `umsim` (run, study, bench, conicity, creep, info, plot, equilibrium, modes, curving) and `umgen`.
+//! The command-line tools: `umsim` (run, study, bench, conicity, creep, info, plot, equilibrium, modes, curving, critical-speed) and `umgen`.
 //! Each subcommand lives in its own module with its clap arguments and a `run`
 //! function; the binaries only dispatch.
 
 pub mod bench;
 pub mod conicity;
 pub mod creep;
+pub mod critical;
 pub mod curving;
 pub mod engine;
 pub mod equilibrium;

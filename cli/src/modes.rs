@@ -4,11 +4,16 @@
 //! by their dominant coordinates; the CSV holds the normalized mode
 //! shapes), or with `--speed` the root locus over speed (CSV: one row per
 //! speed and mode) and the linear critical speed, where the least damped
-//! lateral (hunting) mode's damping ratio crosses zero.
+//! lateral (hunting) mode's damping ratio crosses zero; `--plot FILE` draws
+//! that mode's damping ratio and frequency against speed. `--sweep
+//! NAME=FROM:TO:STEP` is the same over a model parameter at the scenario's
+//! speed (a conicity-setting parameter, a suspension stiffness).
 
 use crate::engine::EngineOptions;
 use railmbs_runtime::analysis::modes::Mode;
-use railmbs_runtime::analysis::speed::{SpeedModes, critical_speed, root_locus, scenario_modes};
+use railmbs_runtime::analysis::speed::{
+    SpeedModes, critical_speed, parameter_locus, root_locus, scenario_modes,
+};
 use railmbs_runtime::forces::ContactTableCache;
 use railmbs_runtime::run::RunError;
 use std::fmt::Write as _;
@@ -24,9 +29,19 @@ pub struct Args {
     /// scenario's own speed.
     #[arg(long, value_name = "FROM:TO:STEP", value_parser = parse_speeds)]
     pub speed: Option<Speeds>,
+    /// A locus over a model parameter, `NAME=FROM:TO:STEP` (the parameter's
+    /// unit), at the scenario's own speed; the critical value where the
+    /// least damped lateral mode's damping ratio crosses zero.
+    #[arg(long, value_name = "NAME=FROM:TO:STEP", value_parser = parse_sweep, conflicts_with = "speed")]
+    pub sweep: Option<(String, Speeds)>,
     /// CSV: the modes with their shapes, or with `--speed` the root locus.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// With `--speed`, a plot (`.svg` or `.png`) of the least damped lateral
+    /// mode's damping ratio and frequency against speed, the linear critical
+    /// speed in the title (its data in a CSV beside it, `FILE.csv`).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
     /// Engine and parameters.
     #[command(flatten)]
     pub engine: EngineOptions,
@@ -61,6 +76,16 @@ pub(crate) fn parse_speeds(text: &str) -> Result<Speeds, String> {
     Ok(Speeds((0..count).map(|k| from + k as f64 * step).collect()))
 }
 
+/// `NAME=FROM:TO:STEP` of `--sweep` (FROM ≥ 0 as for speeds).
+fn parse_sweep(text: &str) -> Result<(String, Speeds), String> {
+    match text.split_once('=') {
+        Some((name, range)) if !name.trim().is_empty() => {
+            Ok((name.trim().to_string(), parse_speeds(range)?))
+        }
+        _ => Err(format!("expected NAME=FROM:TO:STEP, got {text:?}")),
+    }
+}
+
 /// Runs `umsim modes`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let (scenario, model) = args.engine.load(&args.scenario)?;
@@ -78,6 +103,30 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     };
+    if let Some(p) = &args.plot {
+        crate::plot::Format::of(p)?;
+        if args.speed.is_none() && args.sweep.is_none() {
+            return Err("--plot needs --speed or --sweep (a locus to plot)".into());
+        }
+    }
+    if let Some((name, Speeds(values))) = &args.sweep {
+        let start = std::time::Instant::now();
+        let locus = parameter_locus(&scenario, &model, name, values, &mut make)?;
+        let total = start.elapsed().as_secs_f64();
+        let axis = Axis {
+            label: name,
+            values,
+        };
+        print!("{}", describe_locus_over(&locus, &axis, total)?);
+        if let Some(path) = &args.output {
+            write_locus_over(path, &locus, &axis)?;
+            println!("locus written to {}", path.display());
+        }
+        if let Some(plot) = &args.plot {
+            plot_locus_over(plot, args.output.as_deref(), &locus, &axis)?;
+        }
+        return Ok(());
+    }
     match &args.speed {
         None => {
             let start = std::time::Instant::now();
@@ -97,6 +146,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             if let Some(path) = &args.output {
                 write_locus(path, &locus)?;
                 println!("root locus written to {}", path.display());
+            }
+            if let Some(plot) = &args.plot {
+                plot_locus(plot, args.output.as_deref(), &locus)?;
             }
         }
     }
@@ -155,6 +207,76 @@ pub fn describe(one: &SpeedModes, seconds: f64) -> Result<String, std::fmt::Erro
     Ok(s)
 }
 
+/// The variable of a locus: its name (with unit) and its value per point.
+pub struct Axis<'a> {
+    /// `speed[m/s]`, or a parameter's name.
+    pub label: &'a str,
+    /// Its value at each point of the locus.
+    pub values: &'a [f64],
+}
+
+/// The values where the least damped lateral mode's damping ratio crosses
+/// zero first, interpolated linearly (the linear critical speed on a speed
+/// axis).
+fn critical_value(locus: &[SpeedModes], axis: &Axis) -> Option<f64> {
+    let samples: Vec<(f64, f64)> = locus
+        .iter()
+        .zip(axis.values)
+        .filter_map(|(one, &x)| {
+            one.modes
+                .least_damped_lateral()
+                .map(|m| (x, m.damping_ratio))
+        })
+        .collect();
+    railmbs_runtime::analysis::modes::zero_crossing(&samples)
+}
+
+/// The summary of a locus over a parameter: the least damped lateral mode
+/// per value and the critical value.
+pub fn describe_locus_over(
+    locus: &[SpeedModes],
+    axis: &Axis,
+    seconds: f64,
+) -> Result<String, std::fmt::Error> {
+    let mut s = String::new();
+    writeln!(
+        s,
+        "locus over {} at {} values in {:.2} s\n\n{:>11}  f [Hz]     zeta [-]   least damped lateral mode",
+        axis.label,
+        locus.len(),
+        seconds,
+        axis.label
+    )?;
+    lines(&mut s, locus, axis.values)?;
+    match critical_value(locus, axis) {
+        Some(x) => writeln!(
+            s,
+            "\nthe least damped lateral mode's damping ratio crosses zero at {} = {x:.6}",
+            axis.label
+        )?,
+        None => writeln!(
+            s,
+            "\nthe least damped lateral mode's damping ratio does not cross zero in this range"
+        )?,
+    }
+    Ok(s)
+}
+
+/// A line per point: the value and the least damped lateral mode.
+fn lines(s: &mut String, locus: &[SpeedModes], values: &[f64]) -> std::fmt::Result {
+    for (one, x) in locus.iter().zip(values) {
+        match one.modes.least_damped_lateral() {
+            Some(m) => writeln!(
+                s,
+                "{:>11.5}  {:>9.4}  {:>9.4}  {}",
+                x, m.frequency, m.damping_ratio, m.name
+            )?,
+            None => writeln!(s, "{x:>11.5}  (no lateral mode)")?,
+        }
+    }
+    Ok(())
+}
+
 /// The summary of a root locus: the least damped lateral mode per speed and
 /// the critical speed.
 pub fn describe_locus(locus: &[SpeedModes], seconds: f64) -> Result<String, std::fmt::Error> {
@@ -165,16 +287,8 @@ pub fn describe_locus(locus: &[SpeedModes], seconds: f64) -> Result<String, std:
         locus.len(),
         seconds
     )?;
-    for one in locus {
-        match one.modes.least_damped_lateral() {
-            Some(m) => writeln!(
-                s,
-                "{:>11.3}  {:>9.4}  {:>9.4}  {}",
-                one.speed, m.frequency, m.damping_ratio, m.name
-            )?,
-            None => writeln!(s, "{:>11.3}  (no lateral mode)", one.speed)?,
-        }
-    }
+    let speeds: Vec<f64> = locus.iter().map(|one| one.speed).collect();
+    lines(&mut s, locus, &speeds)?;
     match critical_speed(locus) {
         Some(v) => writeln!(
             s,
@@ -243,9 +357,26 @@ fn write_locus(
     path: &std::path::Path,
     locus: &[SpeedModes],
 ) -> Result<(), Box<dyn std::error::Error>> {
+    let speeds: Vec<f64> = locus.iter().map(|one| one.speed).collect();
+    write_locus_over(
+        path,
+        locus,
+        &Axis {
+            label: "speed[m/s]",
+            values: &speeds,
+        },
+    )
+}
+
+/// A locus: a row per point and mode, the first column the axis.
+fn write_locus_over(
+    path: &std::path::Path,
+    locus: &[SpeedModes],
+    axis: &Axis,
+) -> Result<(), Box<dyn std::error::Error>> {
     let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
     w.write_record([
-        "speed[m/s]",
+        axis.label,
         "mode",
         "f[Hz]",
         "fn[Hz]",
@@ -256,10 +387,10 @@ fn write_locus(
         "name",
     ])
     .map_err(|e| csv_error(path, e))?;
-    for one in locus {
+    for (one, x) in locus.iter().zip(axis.values) {
         for (k, m) in one.modes.modes.iter().enumerate() {
             w.write_record([
-                format!("{:?}", one.speed),
+                format!("{x:?}"),
                 (k + 1).to_string(),
                 format!("{:?}", m.frequency),
                 format!("{:?}", m.natural_frequency),
@@ -273,5 +404,81 @@ fn write_locus(
         }
     }
     w.flush().map_err(|e| csv_error(path, e))?;
+    Ok(())
+}
+
+/// The root-locus plot: the least damped lateral mode's damping ratio and
+/// frequency against speed (`umsim plot` of a CSV beside the plot, one row
+/// per speed), the linear critical speed in the title.
+fn plot_locus(
+    plot: &std::path::Path,
+    output: Option<&std::path::Path>,
+    locus: &[SpeedModes],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let speeds: Vec<f64> = locus.iter().map(|one| one.speed).collect();
+    let axis = Axis {
+        label: "speed[m/s]",
+        values: &speeds,
+    };
+    plot_locus_over(plot, output, locus, &axis)
+}
+
+/// [`plot_locus`] over any axis.
+fn plot_locus_over(
+    plot: &std::path::Path,
+    output: Option<&std::path::Path>,
+    locus: &[SpeedModes],
+    axis: &Axis,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let csv = plot.with_extension("csv");
+    if output == Some(csv.as_path()) {
+        return Err(format!(
+            "--plot {} would write its data over the -o file {}",
+            plot.display(),
+            csv.display()
+        )
+        .into());
+    }
+    let mut w = csv::Writer::from_path(&csv).map_err(|e| csv_error(&csv, e))?;
+    w.write_record([axis.label, "zeta[-]", "f[Hz]"])
+        .map_err(|e| csv_error(&csv, e))?;
+    for (one, x) in locus.iter().zip(axis.values) {
+        if let Some(m) = one.modes.least_damped_lateral() {
+            w.write_record([
+                format!("{x:?}"),
+                format!("{:?}", m.damping_ratio),
+                format!("{:?}", m.frequency),
+            ])
+            .map_err(|e| csv_error(&csv, e))?;
+        }
+    }
+    w.flush().map_err(|e| csv_error(&csv, e))?;
+    let title = match critical_value(locus, axis) {
+        Some(v) if axis.label == "speed[m/s]" => format!(
+            "least damped lateral mode; linear critical speed {v:.2} m/s ({:.1} km/h): zeta = 0",
+            3.6 * v
+        ),
+        Some(v) => format!(
+            "least damped lateral mode; zeta = 0 at {} = {v:.5}",
+            axis.label
+        ),
+        None => "least damped lateral mode; its damping ratio does not cross zero here".into(),
+    };
+    crate::plot::run(&crate::plot::Args {
+        input: csv.clone(),
+        y: vec!["zeta[-]".into(), "f[Hz]".into()],
+        x: axis.label.into(),
+        from: None,
+        to: None,
+        title: Some(title),
+        width: 1000,
+        height: None,
+        output: plot.to_path_buf(),
+    })?;
+    println!(
+        "root-locus plot written to {} (data {})",
+        plot.display(),
+        csv.display()
+    );
     Ok(())
 }

@@ -140,13 +140,18 @@
 //!   optional `name` for its result column;
 //! - `CriticalSpeed(column: "B.WS1.ws.y", amplitude: 1e-4, window: 1.0)`:
 //!   for a decelerating run (`speed_profile`), the running speed where the
-//!   lateral limit cycle dies out. The amplitude at time t is half the range
+//!   lateral limit cycle dies out, by the runtime's limit-cycle detection
+//!   (`railmbs_runtime::analysis::critical::LimitCycleDetector`, the one
+//!   `umsim critical-speed` uses). The amplitude at time t is half the range
 //!   (max − min) of `column` over the `window` seconds before t (choose it
-//!   longer than a hunting period). The critical speed is the running speed
-//!   `v[m/s]` at the last output row whose amplitude is at least
-//!   `amplitude` (same unit as the column); it is empty when the amplitude
-//!   never reaches `amplitude` (no limit cycle) or still does at the end of
-//!   the run (the limit cycle survives to the lowest speed).
+//!   longer than a hunting period); a limit cycle is established once the
+//!   amplitude reaches twice `amplitude` (same unit as the column) and has
+//!   died out once it falls below `amplitude` (hysteresis). The critical
+//!   speed is the running speed `v[m/s]` at the last extreme of the last
+//!   limit cycle that died out (the row that left the window as the
+//!   amplitude fell below `amplitude`); it is empty when no limit cycle was
+//!   established or one still goes on at the end of the run (it survives to
+//!   the lowest speed).
 //!
 //! ## The result table
 //!

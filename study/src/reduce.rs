@@ -1,10 +1,10 @@
 //! Per-case reductions to scalars, computed while the run streams its rows
 //! (the [`CaseReducer`] sink), and the assessment from the run's own table.
 
+use railmbs_runtime::analysis::critical::{DetectionSettings, LimitCycleDetector};
 use railmbs_runtime::forces::Assessment;
 use railmbs_runtime::run::{LoadSample, OutputSink, RunError};
 use serde::Deserialize;
-use std::collections::VecDeque;
 
 /// Where a column reduction looks.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -275,50 +275,25 @@ struct ColumnState {
     columns: Vec<(usize, String, Accumulator)>,
 }
 
-/// The critical-speed criterion bound to a column.
+/// The critical-speed criterion bound to a column: the runtime's
+/// limit-cycle detection (the one `umsim critical-speed` uses).
 #[derive(Debug)]
 struct CriticalState {
     column: usize,
     speed: usize,
-    amplitude: f64,
-    window: f64,
-    /// (t, x) of the rows within the window before the last row.
-    recent: VecDeque<(f64, f64)>,
-    /// Running speed at the last row whose amplitude reached the threshold.
-    last_above: Option<f64>,
-    /// Whether the last row's amplitude reached the threshold.
-    above_at_end: bool,
+    distance: Option<usize>,
+    detector: LimitCycleDetector,
 }
 
 impl CriticalState {
-    fn push(&mut self, t: f64, x: f64, v: f64) {
-        self.recent.push_back((t, x));
-        while self
-            .recent
-            .front()
-            .is_some_and(|&(t0, _)| t0 < t - self.window)
-        {
-            self.recent.pop_front();
-        }
-        let (lo, hi) = self
-            .recent
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(_, x)| {
-                (lo.min(x), hi.max(x))
-            });
-        // Half the range over the window: the limit cycle's amplitude.
-        let amplitude = 0.5 * (hi - lo);
-        self.above_at_end = amplitude >= self.amplitude;
-        if self.above_at_end {
-            self.last_above = Some(v);
-        }
+    fn push(&mut self, values: &[f64]) {
+        let s = self.distance.map(|k| values[k]);
+        self.detector
+            .push(values[0], values[self.speed], s, &[values[self.column]]);
     }
 
     fn value(&self) -> f64 {
-        match self.last_above {
-            Some(v) if !self.above_at_end => v,
-            _ => f64::NAN,
-        }
+        self.detector.detection().speed().unwrap_or(f64::NAN)
     }
 }
 
@@ -411,14 +386,14 @@ impl<'a> CaseReducer<'a> {
                             r.name
                         ));
                     };
+                    let detector =
+                        LimitCycleDetector::new(DetectionSettings::new(*window, *amplitude))
+                            .map_err(|e| format!("reduction \"{}\": {e}", r.name))?;
                     State::Critical(CriticalState {
                         column: c,
                         speed,
-                        amplitude: *amplitude,
-                        window: *window,
-                        recent: VecDeque::new(),
-                        last_above: None,
-                        above_at_end: false,
+                        distance: index("s[m]"),
+                        detector,
                     })
                 }
             };
@@ -562,7 +537,7 @@ impl OutputSink for CaseReducer<'_> {
                         }
                     }
                 }
-                State::Critical(c) => c.push(t, values[c.column], values[c.speed]),
+                State::Critical(c) => c.push(values),
             }
         }
         match self.inner.as_mut() {

@@ -1,7 +1,9 @@
 //! `umsim`: the railmbs simulator.
 
 use clap::{Parser, Subcommand};
-use railmbs_cli::{bench, conicity, creep, curving, equilibrium, info, modes, plot, run, study};
+use railmbs_cli::{
+    bench, conicity, creep, critical, curving, equilibrium, info, modes, plot, run, study,
+};
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +38,8 @@ enum Command {
     Modes(modes::Args),
     /// Quasi-static curving: the steady state of the vehicle in a constant curve at constant speed.
     Curving(curving::Args),
+    /// Nonlinear critical speed: a decelerating run's limit-cycle collapse, or a bifurcation diagram.
+    CriticalSpeed(critical::Args),
 }
 
 fn main() {
@@ -51,6 +55,7 @@ fn main() {
         Command::Equilibrium(a) => equilibrium::run(a),
         Command::Modes(a) => modes::run(a),
         Command::Curving(a) => curving::run(a),
+        Command::CriticalSpeed(a) => critical::run(a),
     };
     if let Err(e) = result {
         eprintln!("umsim: error: {e}");

@@ -5,6 +5,7 @@ mod bench_cli;
 mod common;
 mod conicity_cli;
 mod creep_cli;
+mod critical_cli;
 mod info_cli;
 mod plot_cli;
 mod run_cli;

@@ -152,6 +152,25 @@ pub enum EquilibriumError {
         /// (largest 1).
         direction: Vec<(String, f64)>,
     },
+    /// The vehicle is free along its track (a coasting vehicle: nothing
+    /// holds its longitudinal position) and a net longitudinal force (the
+    /// creep forces' rolling resistance) pushes it: no steady state.
+    #[error(
+        "no steady state: the vehicle is free along the track (no force holds a common shift of \
+         {}: a coasting vehicle, stiffness {stiffness:.2e} N/m) and a net longitudinal force of \
+         {force:.3e} N (the creep forces' rolling resistance) pushes it; hold it by a speed \
+         hold, a longitudinal spring and damper from the car body to its track frame (as \
+         Vehicle 1's `k_traction`, `c_traction`)",
+        coordinates.join(", ")
+    )]
+    Coasting {
+        /// The longitudinal coordinates shifted together.
+        coordinates: Vec<String>,
+        /// Stiffness against the common shift, N/m (|Δr|∞ / shift).
+        stiffness: f64,
+        /// Net longitudinal force on them, N.
+        force: f64,
+    },
     /// The model could not be evaluated.
     #[error(transparent)]
     Sim(#[from] SimError),
@@ -212,6 +231,65 @@ fn residual<S: MechanicalSystem + ?Sized>(
         r[k] = full[i];
     }
     Ok((r, full))
+}
+
+/// The coasting vehicle's error, when the unknowns that are longitudinal
+/// translations (x) can shift together with (almost) no restoring force
+/// and a net force pushes them: the stiffness against the common shift
+/// below a thousandth of the heaviest body's weight per metre (about
+/// 300 N/m for Vehicle 1, whose speed hold has 1e6 N/m; coasting, its
+/// shift has 1e-5 N/m) and the net force above the tolerance. A body nested in another's x
+/// would shift twice and stiffen the shift: no false message, only the
+/// general one.
+fn coasting<S: MechanicalSystem + ?Sized>(
+    system: &mut S,
+    eval: &mut ForceEvaluator,
+    unknowns: &Unknowns,
+    names: &[CoordinateInfo],
+    (q, v, lambda): (&[f64], &[f64], &[f64]),
+    r: &DVector<f64>,
+) -> Result<Option<EquilibriumError>, SimError> {
+    use super::CoordinateKind;
+    let along: Vec<usize> = unknowns
+        .map
+        .iter()
+        .filter(|&&(i, role)| {
+            role == Role::Position
+                && names[i].kind == CoordinateKind::Translation(railmbs_models::Axis::X)
+        })
+        .map(|&(i, _)| i)
+        .collect();
+    if along.is_empty() {
+        return Ok(None);
+    }
+    let n = q.len();
+    let heaviest = (0..n).map(|i| eval.mass()[(i, i)]).fold(0.0, f64::max);
+    let force: f64 = unknowns
+        .rows
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| along.contains(i))
+        .map(|(k, _)| r[k])
+        .sum();
+    // A shift of 0.1 mm: far above the rounding of x (~1e-13 m at 1 km)
+    // and small against every length of the model.
+    let h = 1e-4;
+    let mut shifted = q.to_vec();
+    for &i in &along {
+        shifted[i] += h;
+    }
+    let (rs, _) = residual(system, eval, unknowns, (&shifted, v, lambda))?;
+    let stiffness = (rs - r).amax() / h;
+    let tolerance = 1e-9 * (heaviest * 9.81).max(1.0);
+    Ok(
+        (stiffness < 1e-3 * heaviest * 9.81 && force.abs() > tolerance).then(|| {
+            EquilibriumError::Coasting {
+                coordinates: along.iter().map(|&i| names[i].name.clone()).collect(),
+                stiffness,
+                force,
+            }
+        }),
+    )
 }
 
 /// The largest |r| entries of `full` over `which`, named (at most five).
@@ -370,6 +448,9 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
     let mut iterations = 0;
     while !converged(&r) {
         if iterations == settings.max_iterations {
+            if let Some(e) = coasting(system, &mut eval, &unknowns, names, (&q, &v, &lambda), &r)? {
+                return Err(e);
+            }
             return Err(EquilibriumError::NotConverged {
                 iterations,
                 residual: unknowns

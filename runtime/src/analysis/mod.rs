@@ -13,12 +13,15 @@
 //!   frames, with every wheelset's position, angle of attack and contact
 //!   outputs;
 //! - [`speed`]: all three for a scenario at a speed, root loci over speed
-//!   and the linear critical speed.
+//!   and the linear critical speed;
+//! - [`critical`]: the nonlinear critical speed from runs (a decelerating
+//!   run, a bifurcation diagram by continuation in speed).
 //!
 //! Every analysis evaluates the model only through
 //! [`MechanicalSystem::dynamics`] and [`MechanicalSystem::constraints`]:
 //! there is no second model evaluation to keep consistent.
 
+pub mod critical;
 pub mod curving;
 pub mod equilibrium;
 pub mod linear;

@@ -123,6 +123,44 @@ pub fn root_locus(
         .collect()
 }
 
+/// The modes of `scenario` (at its own speed) for each value of the model
+/// parameter `name` in `values` (the parameter's unit), each from its own
+/// steady state; `engine` makes a fresh engine for each (the contact
+/// tables are shared: a parameter of the profiles or the track builds its
+/// own).
+///
+/// # Errors
+/// An unknown parameter, or as [`scenario_modes`], naming the value.
+pub fn parameter_locus(
+    scenario: &Scenario,
+    model: &Model,
+    name: &str,
+    values: &[f64],
+    engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
+) -> Result<Vec<SpeedModes>, RunError> {
+    if model.parameter_index(name).is_none() {
+        return Err(RunError::Setup {
+            file: scenario.source.clone(),
+            message: format!(
+                "--sweep: model \"{}\" has no parameter \"{name}\" (`umsim info` lists them)",
+                model.name
+            ),
+        });
+    }
+    let tables = ContactTableCache::new();
+    values
+        .iter()
+        .map(|&x| {
+            let mut s = scenario.clone();
+            s.set_parameter(name, &format!("{x:?}"));
+            scenario_modes(&s, model, engine()?, &tables).map_err(|e| RunError::Setup {
+                file: scenario.source.clone(),
+                message: format!("at {name} = {x}: {e}"),
+            })
+        })
+        .collect()
+}
+
 /// The linear critical speed of a root locus (sorted by speed), m/s: where
 /// the damping ratio of the least damped lateral mode
 /// ([`Modes::least_damped_lateral`]) first crosses zero, interpolated

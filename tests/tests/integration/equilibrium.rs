@@ -274,3 +274,26 @@ fn two_bodies_joined_only_to_each_other_are_an_unconstrained_direction() {
     assert!((direction[0].1 - direction[1].1).abs() < 1e-9, "{err}");
     assert!(err.to_string().contains("no force resists"), "{err}");
 }
+
+/// Vehicle 1 coasting (its speed hold `k_traction`, `c_traction` set to
+/// zero): nothing holds it along the track and the spin creep's rolling
+/// resistance pushes it, so there is no steady state; the error says so,
+/// naming the longitudinal coordinates, instead of "no equilibrium within
+/// N iterations".
+#[test]
+fn a_coasting_vehicle_is_told_it_has_no_steady_state() {
+    let (s, model) = equilibrium_scenario(
+        "vehicle1_equilibrium_straight.ron",
+        &[("k_traction", "0"), ("c_traction", "0")],
+    );
+    let err = match scenario_system(&s, &model, Box::new(NumericEquations::new(&model))) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("a coasting vehicle has no steady state"),
+    };
+    assert!(err.contains("free along the track"), "{err}");
+    assert!(
+        err.contains("body.x") && err.contains("k_traction"),
+        "{err}"
+    );
+    assert!(!err.contains("iterations"), "{err}");
+}

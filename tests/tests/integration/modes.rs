@@ -215,3 +215,34 @@ fn a_parallelogram_four_bar_closed_by_a_cut_joint_swings_as_a_compound_pendulum(
         modes[0].im
     );
 }
+
+/// `umsim modes --sweep k=…`'s locus over a parameter: the mass on a
+/// spring at k = 100, 400, 900 N/m has ω = √(k/m) = 10, 20, 30 rad/s and
+/// keeps ζ = 0.1 (its damper is 2 ζ √(k m)), to 1e-8 as above.
+#[test]
+fn a_sweep_over_a_parameter_follows_the_analytic_frequency() {
+    use railmbs_runtime::analysis::speed::parameter_locus;
+    let (s, model) = scenario("spring_mass.ron", &[]);
+    let values = [100.0, 400.0, 900.0];
+    let mut engine = || -> Result<Box<dyn Equations>, railmbs_runtime::run::RunError> {
+        Ok(Box::new(NumericEquations::new(&model)))
+    };
+    let locus = parameter_locus(&s, &model, "k", &values, &mut engine).unwrap();
+    for (one, k) in locus.iter().zip(values) {
+        let m = &one.modes.modes[0];
+        let omega = k.sqrt();
+        assert!(
+            (m.natural_frequency - omega / (2.0 * std::f64::consts::PI)).abs() < 1e-8 * omega,
+            "k = {k}: {m:?}"
+        );
+        assert!((m.damping_ratio - 0.1).abs() < 1e-8, "k = {k}: {m:?}");
+    }
+    let mut engine = || -> Result<Box<dyn Equations>, railmbs_runtime::run::RunError> {
+        Ok(Box::new(NumericEquations::new(&model)))
+    };
+    let err = parameter_locus(&s, &model, "stiffness", &values, &mut engine).unwrap_err();
+    assert!(
+        err.to_string().contains("no parameter \"stiffness\""),
+        "{err}"
+    );
+}
