@@ -26,7 +26,20 @@ fn info_lists_what_a_model_offers() {
     let out = text(&o.stdout);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(out.contains("8 bodies, 42 coordinates"), "{out}");
-    assert!(out.contains("  mc = 32000  car body mass, kg"), "{out}");
+    assert!(
+        out.contains("  mc = 32000 [kg]  car body mass, kg"),
+        "{out}"
+    );
+    // The unit column: from the doc's last ", UNIT" (before a remark), "-"
+    // for a parameter whose doc gives none (the friction coefficient).
+    for line in [
+        "  Bogie1.WS1.Iyy = 112 [kg m2]  spin inertia, kg m2",
+        "  kyaw2 = 10500 [N m/rad]  ",
+        "  Bogie1.WS1.penetration = 0.000236 [m]  ",
+        "  mu = 0.4 [-]  wheel–rail coefficient of friction",
+    ] {
+        assert!(out.contains(line), "no {line:?} in\n{out}");
+    }
     assert!(
         out.contains("  Bogie1.WS1.contact (WheelRail): L.Q [N], L.Y [N], L.Y/Q [-]"),
         "{out}"
