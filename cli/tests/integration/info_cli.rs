@@ -53,3 +53,58 @@ fn info_lists_what_a_model_offers() {
         text(&o.stderr)
     );
 }
+
+/// Units in every `--help` (issue 18): each option with a physical quantity
+/// names its unit, in its value name or its help text, command by command.
+#[test]
+fn every_help_names_the_units_of_its_quantities() {
+    let cases: [(&str, &[&str]); 6] = [
+        (
+            "run",
+            &["--end-time <SECONDS>", "in the parameter's own unit, SI"],
+        ),
+        (
+            "conicity",
+            &[
+                "--gauge <MM>",
+                "--flange-back <MM>",
+                "--diameters <MM,MM>",
+                "--smoothing <MM>",
+            ],
+        ),
+        (
+            "creep",
+            &[
+                "contact semi-axes, m",
+                "combined shear modulus, Pa",
+                "normal force, N",
+                "spin creepage, 1/m",
+                "Mz in N·m",
+            ],
+        ),
+        (
+            "curving",
+            &["--radius <M>", "--cant <M>", "--speed <M/S|FROM:TO:STEP>"],
+        ),
+        ("modes", &["`FROM:TO:STEP` (m/s)"]),
+        (
+            "plot",
+            &[
+                "--width <PIXELS>",
+                "--height <PIXELS>",
+                "s for time, m for `s[m]`",
+            ],
+        ),
+    ];
+    for (command, needles) in cases {
+        let o = umsim(&[command, "--help"]);
+        let out = text(&o.stdout);
+        assert!(o.status.success(), "{command}: {}", text(&o.stderr));
+        for needle in needles {
+            assert!(
+                out.contains(needle),
+                "umsim {command} --help lacks {needle:?}:\n{out}"
+            );
+        }
+    }
+}
