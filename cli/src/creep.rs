@@ -32,8 +32,9 @@
 //! and mean `dF/muN` per law goes to standard error.
 
 use railmbs_wheelrail::creep::{
-    ContactPatch, CreepForces, CreepLaw, CreepLawSpec, Creepages, INTEGRATED_NODES, SlidingZone,
+    CreepForces, CreepLaw, CreepLawSpec, INTEGRATED_NODES, SlidingZone,
 };
+use railmbs_wheelrail::creep_cases::{Case, read_cases};
 use std::io::{Read, Write};
 use std::path::PathBuf;
 
@@ -102,8 +103,6 @@ pub struct Args {
     pub output: Option<PathBuf>,
 }
 
-const COLUMNS: [&str; 9] = ["a", "b", "G", "nu", "mu", "N", "xi", "eta", "phi"];
-
 impl Args {
     /// The law of `--method` with the settings of `--strips`, `--elements`,
     /// `--sliding` and `--nodes` applied; an error for a flag the law has no
@@ -156,71 +155,6 @@ impl Args {
         }
         Ok(spec)
     }
-}
-
-/// One case of a cases file: the patch, the creepages, and where it is (data
-/// row, 1-based, and file line) for messages.
-struct Case {
-    patch: ContactPatch,
-    creepages: Creepages,
-    row: usize,
-    line: u64,
-}
-
-/// Reads every case of the CSV in `input`; `source` names it in messages.
-fn read_cases<R: Read>(input: R, source: &str) -> Result<Vec<Case>, String> {
-    let mut rd = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(input);
-    let header = rd
-        .headers()
-        .map_err(|e| format!("{source}: cannot read the header: {e}"))?
-        .clone();
-    let mut idx = [0usize; 9];
-    for (k, name) in COLUMNS.iter().enumerate() {
-        idx[k] = header.iter().position(|h| h == *name).ok_or_else(|| {
-            format!(
-                "{source}: missing column '{name}' (need {}; found {})",
-                COLUMNS.join(","),
-                header.iter().collect::<Vec<_>>().join(",")
-            )
-        })?;
-    }
-    let mut cases = Vec::new();
-    for (row, rec) in rd.records().enumerate() {
-        let row = row + 1;
-        let rec = rec.map_err(|e| format!("{source}: row {row}: {e}"))?;
-        let line = rec.position().map_or(0, |p| p.line());
-        let mut v = [0.0; 9];
-        for k in 0..9 {
-            let s = rec.get(idx[k]).unwrap_or("");
-            v[k] = s.parse::<f64>().map_err(|_| {
-                format!(
-                    "{source}: row {row} (line {line}), column '{}': '{s}' is not a number",
-                    COLUMNS[k]
-                )
-            })?;
-        }
-        cases.push(Case {
-            patch: ContactPatch {
-                a: v[0],
-                b: v[1],
-                g: v[2],
-                nu: v[3],
-                mu: v[4],
-                n: v[5],
-            },
-            creepages: Creepages {
-                xi: v[6],
-                eta: v[7],
-                phi: v[8],
-            },
-            row,
-            line,
-        });
-    }
-    Ok(cases)
 }
 
 /// The forces of `law` for `case`: an error naming the case's row and line

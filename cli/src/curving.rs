@@ -23,13 +23,13 @@ pub struct Args {
     /// its initial state is the starting guess).
     pub scenario: PathBuf,
     /// Curve radius, m: positive for a left curve, negative for a right one.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub radius: f64,
     /// Cant (outer rail above the inner), m.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_name = "M", default_value_t = 0.0)]
     pub cant: f64,
     /// Running speed, m/s, or a sweep `FROM:TO:STEP`.
-    #[arg(long, value_parser = parse_speed_or_sweep)]
+    #[arg(long, value_name = "M/S|FROM:TO:STEP", value_parser = parse_speed_or_sweep)]
     pub speed: Speeds,
     /// CSV: one row per speed and wheelset.
     #[arg(short, long)]

@@ -82,7 +82,8 @@ pub fn describe(
     let names = model.parameter_names();
     writeln!(
         s,
-        "\nparameters ({}): name = value (default expression) description",
+        "\nparameters ({}): name = value (default expression) [unit, from the description; \
+         ? if none] description",
         names.len()
     )?;
     for (k, p) in model.parameters.iter().enumerate() {
@@ -99,7 +100,10 @@ pub fn describe(
         } else {
             format!("  {}", p.doc)
         };
-        writeln!(s, "  {} = {shown}{doc}", p.name)?;
+        // The unit as the doc gives it (`Parameter::unit`): "-" for a doc
+        // without one (dimensionless), "?" without a doc.
+        let unit = p.unit().unwrap_or(if p.doc.is_empty() { "?" } else { "-" });
+        writeln!(s, "  {} = {shown} [{unit}]{doc}", p.name)?;
     }
     if !model.macros.is_empty() {
         writeln!(s, "\nmacros ({}):", model.macros.len())?;

@@ -51,10 +51,10 @@ pub struct Args {
     #[arg(long)]
     pub title: Option<String>,
     /// Width of the picture in pixels.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, value_name = "PIXELS", default_value_t = 1000)]
     pub width: u32,
     /// Height of the picture in pixels [default: 60 + 280 per panel, + 40 with a title].
-    #[arg(long)]
+    #[arg(long, value_name = "PIXELS")]
     pub height: Option<u32>,
     /// Output file: `.svg` or `.png`.
     #[arg(short = 'o', long, value_name = "FILE")]

@@ -33,13 +33,14 @@ impl<'a> Locator<'a> {
             let c = bytes[i];
             if c.is_ascii_whitespace() {
                 i += 1;
-            } else if src[i..].starts_with("//") {
+            } else if bytes[i..].starts_with(b"//") {
                 while i < bytes.len() && bytes[i] != b'\n' {
                     i += 1;
                 }
-            } else if src[i..].starts_with("/*") {
+            } else if bytes[i..].starts_with(b"/*") {
                 i += 2;
-                while i < bytes.len() && !src[i..].starts_with("*/") {
+                // Bytes, not chars: the comment may hold multi-byte characters.
+                while i < bytes.len() && !bytes[i..].starts_with(b"*/") {
                     i += 1;
                 }
                 i = (i + 2).min(bytes.len());

@@ -201,8 +201,57 @@ pub struct Parameter {
     pub name: String,
     /// Default: an expression over other parameters (never `t`).
     pub default: Expr,
-    /// Free text (units, meaning).
+    /// Free text (meaning, then the unit after the last comma: "car body
+    /// mass, kg"; see [`Parameter::unit`]).
     pub doc: String,
+}
+
+impl Parameter {
+    /// The unit the doc text gives after a `", "` (the last such that is a
+    /// unit), before an optional remark (`" (…"`, `": …"` or `", …"`): "N
+    /// s/m" of "primary lateral damping, N s/m (choice)", "m" of "initial
+    /// sinking, m: the static position …, so runs start near equilibrium";
+    /// a doc of a unit alone is that unit. Only SI-style symbols are taken for units
+    /// (`kg m2`, `N/m`, `m/s2`, `N m/rad`, `1/m`, …; see [`is_unit`]); `None`
+    /// if the doc gives none (a dimensionless parameter, or no doc).
+    pub fn unit(&self) -> Option<&str> {
+        let doc = self.doc.as_str();
+        // After a ", ", the last first; then the whole doc.
+        let mut starts: Vec<usize> = doc.match_indices(", ").map(|(i, _)| i + 2).collect();
+        starts.reverse();
+        starts.push(0);
+        starts.into_iter().find_map(|start| {
+            let tail = &doc[start..];
+            let end = [tail.find(" ("), tail.find(':'), tail.find(',')]
+                .into_iter()
+                .flatten()
+                .min()
+                .unwrap_or(tail.len());
+            let unit = tail[..end].trim();
+            is_unit(unit).then_some(unit)
+        })
+    }
+}
+
+/// Whether `text` is a unit written with SI symbols: words separated by
+/// spaces (a product), each a `/`-separated chain of symbols (`m`, `kg`,
+/// `s`, `N`, `rad`, `Pa`, …) with an optional power (`2`, `3`, `²`, `³`), or
+/// `1` before a `/` (`1/m`).
+pub fn is_unit(text: &str) -> bool {
+    const SYMBOLS: [&str; 20] = [
+        "m", "mm", "km", "kg", "t", "g", "s", "h", "min", "N", "kN", "rad", "deg", "Pa", "MPa",
+        "GPa", "Hz", "W", "J", "K",
+    ];
+    let atom = |a: &str| {
+        let base = a.trim_end_matches(['2', '3', '4', '²', '³', '⁴']);
+        SYMBOLS.contains(&base)
+    };
+    !text.is_empty()
+        && text.split(' ').all(|word| {
+            let mut parts = word.split('/');
+            let first = parts.next().unwrap_or("");
+            (atom(first) || (first == "1" && word.contains('/'))) && parts.all(atom)
+        })
 }
 
 /// A named set of assignments applied at once ("loaded", a wedge type...).

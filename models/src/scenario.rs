@@ -144,14 +144,7 @@ impl PendingTrack {
     /// column, build errors (geometry, irregularity files) naming the file.
     fn load(self) -> Result<ScenarioTrack, ModelErrors> {
         let text = crate::error::read_text(&self.file, "track")?;
-        let loc = Locator::new(&text);
-        let description: TrackDescription = ron::Options::default()
-            .from_str(&text)
-            .map_err(|e| ron_error(&loc, &self.file, e))?;
-        let base = self.file.parent().unwrap_or(Path::new(""));
-        let track = description
-            .build(base)
-            .map_err(|e| ModelErrors(vec![ModelError::new(&self.file, "track", e.to_string())]))?;
+        let track = parse_track(&text, &self.file)?;
         Ok(ScenarioTrack {
             file: self.file,
             start: self.start,
@@ -160,6 +153,21 @@ impl PendingTrack {
             track: Arc::new(track),
         })
     }
+}
+
+/// Parses and builds the text of the track file `file` (RON,
+/// `railmbs_track::TrackDescription`): RON errors with line and column, build
+/// errors (geometry, irregularity files, read relative to `file`'s folder)
+/// naming the file.
+pub fn parse_track(text: &str, file: &Path) -> Result<Track, ModelErrors> {
+    let loc = Locator::new(text);
+    let description: TrackDescription = ron::Options::default()
+        .from_str(text)
+        .map_err(|e| ron_error(&loc, file, e))?;
+    let base = file.parent().unwrap_or(Path::new(""));
+    description
+        .build(base)
+        .map_err(|e| ModelErrors(vec![ModelError::new(file, "track", e.to_string())]))
 }
 
 /// A resolved scenario.
@@ -202,6 +210,7 @@ use crate::locate::Locator;
 use crate::model::Model;
 use crate::raw::{OrderedMap, Value};
 use railmbs_track::{Track, TrackDescription};
+use railmbs_wheelrail::readable;
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
 use std::sync::Arc;
@@ -400,16 +409,6 @@ pub const MAX_OUTPUT_ROWS: f64 = 1e8;
 /// (a one-body model) 10⁹ steps are a quarter of an hour; a vehicle takes
 /// a hundred times longer.
 pub const MAX_STEPS: f64 = 1e9;
-
-/// `x` as written for a reader: plain between 10⁻⁴ and 10⁶, else with an
-/// exponent (Rust's `{}` writes 1e-308 with 308 digits).
-fn readable(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
 
 /// Why a run of `end_time` (s) with `integrator` and output `interval` (s)
 /// could not finish or would fill the disk: (field, message) for more than

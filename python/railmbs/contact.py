@@ -138,8 +138,8 @@ class Wheelset:
         ``contact_angle`` (rad, positive towards the flange), ``wheel_y``,
         ``wheel_z`` (m, wheelset frame), ``rail_y``, ``rail_z`` (m, track
         frame), ``wheel_u``, ``rail_u`` (m, profile coordinates), ``gap`` (m),
-        curvatures (1/m), ``yaw_lead`` (m/rad) and ``count`` (1 or 2 contact
-        points). ``delta_r`` = r_left − r_right (m).
+        curvatures (1/m), ``yaw_lead`` (m/rad), ``distance_slope`` (–) and
+        ``count`` (1 or 2 contact points). ``delta_r`` = r_left − r_right (m).
         """
         shape, (yf, rf) = _flat(y, roll)
         d = _shaped(self._inner._contacts(yf, rf), shape)

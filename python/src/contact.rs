@@ -179,48 +179,13 @@ struct SideColumns {
 }
 
 /// Names of the fields of [`Contact`] returned per wheel (units in
-/// [`contact_values`]).
-const FIELDS: [&str; 13] = [
-    "gap",
-    "wheel_u",
-    "rail_u",
-    "wheel_y",
-    "wheel_z",
-    "rail_y",
-    "rail_z",
-    "contact_angle",
-    "rolling_radius",
-    "wheel_longitudinal_curvature",
-    "wheel_transverse_curvature",
-    "rail_transverse_curvature",
-    "yaw_lead",
-];
-
-/// The values of [`FIELDS`] of a contact: gap m, wheel_u m, rail_u m,
-/// wheel_y m, wheel_z m, rail_y m, rail_z m, contact angle rad, rolling
-/// radius m, curvatures 1/m, yaw lead m/rad.
-fn contact_values(c: &Contact) -> [f64; FIELDS.len()] {
-    [
-        c.gap,
-        c.wheel_u,
-        c.rail_u,
-        c.wheel_y,
-        c.wheel_z,
-        c.rail_y,
-        c.rail_z,
-        c.contact_angle,
-        c.rolling_radius,
-        c.wheel_longitudinal_curvature,
-        c.wheel_transverse_curvature,
-        c.rail_transverse_curvature,
-        c.yaw_lead,
-    ]
-}
+/// [`Contact::values`]).
+const FIELDS: [&str; 14] = Contact::FIELDS;
 
 impl SideColumns {
     fn push(&mut self, set: &ContactSet) {
         self.count.push(set.count as f64);
-        for (col, v) in self.fields.iter_mut().zip(contact_values(set.deepest())) {
+        for (col, v) in self.fields.iter_mut().zip(set.deepest().values()) {
             col.push(v);
         }
     }

@@ -186,7 +186,6 @@ fn error_chain(e: &dyn std::error::Error) -> String {
 /// loader maps it: mapping a truncated library crashes the process with
 /// SIGBUS when a page past the end of the file is touched.
 fn check_library_file(path: &Path) -> Result<(), PluginError> {
-    use object::{Object, ObjectSegment};
     let not_a_library = |reason: String| PluginError::NotALibrary {
         path: path.to_path_buf(),
         reason,
@@ -198,16 +197,29 @@ fn check_library_file(path: &Path) -> Result<(), PluginError> {
         .metadata()
         .map_err(|e| not_a_library(e.to_string()))?
         .len();
-    let data = object::ReadCache::new(file);
-    let parsed = object::File::parse(&data)
-        .map_err(|e| not_a_library(format!("not an object file the loader can map ({e})")))?;
+    check_object_headers(&object::ReadCache::new(file), len).map_err(not_a_library)
+}
+
+/// The check of [`Plugin::open`] before the system loader maps a file, on
+/// the file's bytes in memory: `Err` with the reason unless `bytes` is an
+/// object file whose every segment lies inside it.
+pub fn check_library_bytes(bytes: &[u8]) -> Result<(), String> {
+    check_object_headers(bytes, bytes.len() as u64)
+}
+
+/// The object file in `data` (`len` bytes) parses and its segments end
+/// within it.
+fn check_object_headers<'a, R: object::ReadRef<'a>>(data: R, len: u64) -> Result<(), String> {
+    use object::{Object, ObjectSegment};
+    let parsed = object::File::parse(data)
+        .map_err(|e| format!("not an object file the loader can map ({e})"))?;
     for segment in parsed.segments() {
         let (offset, size) = segment.file_range();
         let end = offset.saturating_add(size);
         if end > len {
-            return Err(not_a_library(format!(
+            return Err(format!(
                 "truncated: a segment ends at byte {end}, the file has {len} bytes"
-            )));
+            ));
         }
     }
     Ok(())

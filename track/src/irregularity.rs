@@ -367,11 +367,17 @@ impl MeasuredIrregularity {
     /// a comment line). Errors name the file and the line.
     pub fn from_csv(path: impl AsRef<Path>) -> Result<Self, TrackError> {
         let path = path.as_ref();
-        let file = path.to_path_buf();
         let text = std::fs::read_to_string(path).map_err(|e| TrackError::Io {
-            file: file.clone(),
+            file: path.to_path_buf(),
             message: e.to_string(),
         })?;
+        Self::from_csv_text(&text, path)
+    }
+
+    /// Parses the text of a CSV file as [`MeasuredIrregularity::from_csv`]
+    /// reads it; `path` names the file in errors.
+    pub fn from_csv_text(text: &str, path: &Path) -> Result<Self, TrackError> {
+        let file = path.to_path_buf();
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
             .trim(csv::Trim::All)

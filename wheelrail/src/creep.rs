@@ -86,7 +86,7 @@ pub struct CreepForces {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CreepError {
     /// An input is out of its valid range or not finite.
-    #[error("creep force: {name} = {} is invalid ({expected})", readable(*value))]
+    #[error("creep force: {name} = {} is invalid ({expected})", crate::readable(*value))]
     Input {
         /// Input name as in the CSV interface (`a`, `b`, `G`, `nu`, `mu`, `N`, `xi`, `eta`, `phi`).
         name: &'static str,
@@ -98,16 +98,6 @@ pub enum CreepError {
     /// Bad law parameters (number of strips, elements, exponent).
     #[error("creep force law: {0}")]
     Parameter(String),
-}
-
-/// `x` as written for a reader: plain between 10⁻⁴ and 10⁶, else with an
-/// exponent (Rust's `{}` writes 1e100 with 100 digits).
-fn readable(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }
 
 /// A creep-force law.

@@ -272,6 +272,67 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// Names of the fields, in the order of [`Contact::values`].
+    pub const FIELDS: [&'static str; 14] = [
+        "gap",
+        "wheel_u",
+        "rail_u",
+        "wheel_y",
+        "wheel_z",
+        "rail_y",
+        "rail_z",
+        "contact_angle",
+        "rolling_radius",
+        "wheel_longitudinal_curvature",
+        "wheel_transverse_curvature",
+        "rail_transverse_curvature",
+        "yaw_lead",
+        "distance_slope",
+    ];
+
+    /// The fields in the order of [`Contact::FIELDS`]: gap, wheel_u, rail_u,
+    /// wheel_y, wheel_z, rail_y, rail_z (m), contact angle (rad), rolling
+    /// radius (m), the three curvatures (1/m), yaw lead (m/rad), distance
+    /// slope (–).
+    pub fn values(&self) -> [f64; 14] {
+        [
+            self.gap,
+            self.wheel_u,
+            self.rail_u,
+            self.wheel_y,
+            self.wheel_z,
+            self.rail_y,
+            self.rail_z,
+            self.contact_angle,
+            self.rolling_radius,
+            self.wheel_longitudinal_curvature,
+            self.wheel_transverse_curvature,
+            self.rail_transverse_curvature,
+            self.yaw_lead,
+            self.distance_slope,
+        ]
+    }
+
+    /// The contact of [`Contact::values`]' array `a`.
+    pub fn from_values(a: [f64; 14]) -> Contact {
+        Contact {
+            gap: a[0],
+            wheel_u: a[1],
+            rail_u: a[2],
+            wheel_y: a[3],
+            wheel_z: a[4],
+            rail_y: a[5],
+            rail_z: a[6],
+            contact_angle: a[7],
+            rolling_radius: a[8],
+            wheel_longitudinal_curvature: a[9],
+            wheel_transverse_curvature: a[10],
+            rail_transverse_curvature: a[11],
+            yaw_lead: a[12],
+            distance_slope: a[13],
+        }
+    }
+
     /// Longitudinal position (m) of the contact in the wheelset frame for yaw `psi` (rad).
     pub fn longitudinal_offset(&self, psi: f64) -> f64 {
         self.yaw_lead * psi
@@ -1118,12 +1179,12 @@ impl ContactTable {
                     if wt == 0.0 {
                         continue;
                     }
-                    let v = to_array(&nodes[ci * self.nr + cj][slot]);
+                    let v = nodes[ci * self.nr + cj][slot].values();
                     for (a, v) in acc.iter_mut().zip(v) {
                         *a += wt * v;
                     }
                 }
-                let mut c = from_array(acc);
+                let mut c = Contact::from_values(acc);
                 c.gap = gap;
                 // ∂gap/∂y_s = −tan δ (moving the wheel outwards onto a surface
                 // inclined by δ closes the gap by tan δ per metre).
@@ -1152,42 +1213,4 @@ fn region_split(rigid: &[RigidContact], side: usize) -> f64 {
         }
     }
     split
-}
-
-fn to_array(c: &Contact) -> [f64; 14] {
-    [
-        c.gap,
-        c.wheel_u,
-        c.rail_u,
-        c.wheel_y,
-        c.wheel_z,
-        c.rail_y,
-        c.rail_z,
-        c.contact_angle,
-        c.rolling_radius,
-        c.wheel_longitudinal_curvature,
-        c.wheel_transverse_curvature,
-        c.rail_transverse_curvature,
-        c.yaw_lead,
-        c.distance_slope,
-    ]
-}
-
-fn from_array(a: [f64; 14]) -> Contact {
-    Contact {
-        gap: a[0],
-        wheel_u: a[1],
-        rail_u: a[2],
-        wheel_y: a[3],
-        wheel_z: a[4],
-        rail_y: a[5],
-        rail_z: a[6],
-        contact_angle: a[7],
-        rolling_radius: a[8],
-        wheel_longitudinal_curvature: a[9],
-        wheel_transverse_curvature: a[10],
-        rail_transverse_curvature: a[11],
-        yaw_lead: a[12],
-        distance_slope: a[13],
-    }
 }

@@ -23,9 +23,21 @@ pub const SOURCE_DIGEST: &str = env!("RAILMBS_WHEELRAIL_SOURCE_DIGEST");
 
 pub mod conicity;
 pub mod creep;
+pub mod creep_cases;
 pub mod creepage;
 pub mod elastic_rail;
 pub mod geometry;
 pub mod hertz;
 pub mod kalker;
 pub mod profile;
+
+/// `x` as written for a reader in a message: plain between 10⁻⁴ and 10⁶ (and
+/// 0, ±inf, NaN), else with an exponent (Rust's `{}` writes 1e100 with 100
+/// digits and 1e-308 with 308).
+pub fn readable(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

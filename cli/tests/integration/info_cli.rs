@@ -26,7 +26,20 @@ fn info_lists_what_a_model_offers() {
     let out = text(&o.stdout);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(out.contains("8 bodies, 42 coordinates"), "{out}");
-    assert!(out.contains("  mc = 32000  car body mass, kg"), "{out}");
+    assert!(
+        out.contains("  mc = 32000 [kg]  car body mass, kg"),
+        "{out}"
+    );
+    // The unit column: from the doc's last ", UNIT" (before a remark), "-"
+    // for a parameter whose doc gives none (the friction coefficient).
+    for line in [
+        "  Bogie1.WS1.Iyy = 112 [kg m2]  spin inertia, kg m2",
+        "  kyaw2 = 10500 [N m/rad]  ",
+        "  Bogie1.WS1.penetration = 0.000236 [m]  ",
+        "  mu = 0.4 [-]  wheel–rail coefficient of friction",
+    ] {
+        assert!(out.contains(line), "no {line:?} in\n{out}");
+    }
     assert!(
         out.contains("  Bogie1.WS1.contact (WheelRail): L.Q [N], L.Y [N], L.Y/Q [-]"),
         "{out}"
@@ -39,4 +52,59 @@ fn info_lists_what_a_model_offers() {
         "{}",
         text(&o.stderr)
     );
+}
+
+/// Units in every `--help` (issue 18): each option with a physical quantity
+/// names its unit, in its value name or its help text, command by command.
+#[test]
+fn every_help_names_the_units_of_its_quantities() {
+    let cases: [(&str, &[&str]); 6] = [
+        (
+            "run",
+            &["--end-time <SECONDS>", "in the parameter's own unit, SI"],
+        ),
+        (
+            "conicity",
+            &[
+                "--gauge <MM>",
+                "--flange-back <MM>",
+                "--diameters <MM,MM>",
+                "--smoothing <MM>",
+            ],
+        ),
+        (
+            "creep",
+            &[
+                "contact semi-axes, m",
+                "combined shear modulus, Pa",
+                "normal force, N",
+                "spin creepage, 1/m",
+                "Mz in N·m",
+            ],
+        ),
+        (
+            "curving",
+            &["--radius <M>", "--cant <M>", "--speed <M/S|FROM:TO:STEP>"],
+        ),
+        ("modes", &["`FROM:TO:STEP` (m/s)"]),
+        (
+            "plot",
+            &[
+                "--width <PIXELS>",
+                "--height <PIXELS>",
+                "s for time, m for `s[m]`",
+            ],
+        ),
+    ];
+    for (command, needles) in cases {
+        let o = umsim(&[command, "--help"]);
+        let out = text(&o.stdout);
+        assert!(o.status.success(), "{command}: {}", text(&o.stderr));
+        for needle in needles {
+            assert!(
+                out.contains(needle),
+                "umsim {command} --help lacks {needle:?}:\n{out}"
+            );
+        }
+    }
 }

@@ -405,3 +405,19 @@ fn elastic_rail_lateral_damping_mode() {
             .is_err()
     );
 }
+
+/// Found by `fuzz/run` (target `study`): a `/* */` comment holding a
+/// multi-byte character (`kx·b1²`) made the locator slice inside the
+/// character and panic. Now the error is reported as for any other text.
+#[test]
+fn block_comment_with_multibyte_characters_is_no_panic() {
+    let file = std::path::Path::new("comment.ron");
+    for text in [
+        "/* stiffness, kx·b1² per axlebox */ Model(",
+        "/* unterminated kx·b1²",
+        "// kx·b1²\n/* · */ Model(name: 1)",
+    ] {
+        let e = railmbs_models::parse_model(text, file).expect_err(text);
+        assert!(e.to_string().contains("comment.ron"), "{e}");
+    }
+}

@@ -136,3 +136,60 @@ fn structural_hash_changes_with_structure() {
         assert_ne!(m.structural_hash(), h, "changing {from} to {to}");
     }
 }
+
+/// `Parameter::unit`: the unit after the doc's last ", " (before a remark),
+/// only SI-style symbols; the docs of the bundled models as written.
+#[test]
+fn parameter_units_from_docs() {
+    let unit = |doc: &str| {
+        railmbs_models::Parameter {
+            name: "p".into(),
+            default: railmbs_models::Expr::num(1.0),
+            doc: doc.into(),
+        }
+        .unit()
+        .map(str::to_owned)
+    };
+    for (doc, expected) in [
+        ("car body mass whose half the bogie carries, kg", Some("kg")),
+        ("gravitational acceleration, m/s2", Some("m/s2")),
+        (
+            "wheelset roll inertia, kg m2 (estimate: two 920 mm wheels)",
+            Some("kg m2"),
+        ),
+        ("primary lateral damping, N s/m (choice)", Some("N s/m")),
+        ("yaw stiffness, N m/rad", Some("N m/rad")),
+        (
+            "static deflection, m: the static position under an axle load",
+            Some("m"),
+        ),
+        (
+            "initial sinking, m: the static position under a Vehicle 1 axle load (109 kN) \
+             on S1002/UIC60 1:40, so runs start near equilibrium",
+            Some("m"),
+        ),
+        (
+            "running speed at the start (initial spin v0/r0), m/s",
+            Some("m/s"),
+        ),
+        ("kg", Some("kg")),
+        ("spin creepage, 1/m", Some("1/m")),
+        ("wheel–rail coefficient of friction", None),
+        ("a fraction of the static spring load (choice)", None),
+        ("settled from rest, so runs start near equilibrium", None),
+        ("lateral spacing (UIC 510-2)", None),
+        ("", None),
+    ] {
+        assert_eq!(unit(doc).as_deref(), expected, "doc {doc:?}");
+    }
+    // The bundled Vehicle 1 as loaded (its subsystems' parameters included).
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("vehicles/vehicle1.ron");
+    let model = railmbs_models::load_model(&file).expect("vehicle1 loads");
+    let unit_of = |name: &str| {
+        let p = model.parameters.iter().find(|p| p.name == name);
+        p.expect(name).unit()
+    };
+    assert_eq!(unit_of("mc"), Some("kg"));
+    assert_eq!(unit_of("g"), Some("m/s2"));
+    assert_eq!(unit_of("mu"), None);
+}

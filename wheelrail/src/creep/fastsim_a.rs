@@ -113,12 +113,8 @@ const MAX_STRIPS: usize = 100_000;
 /// FastSim_A with a given number of strips.
 #[derive(Debug, Clone)]
 pub struct FastsimA {
-    /// Per strip: (η = y/b at the strip centre, √(1 − η²) = a_y/a).
-    strip_geom: Vec<(f64, f64)>,
-    /// Σ (4/3)(1 − η²)^(3/2)·Δη: the strips' bound integral for a = b = 1.
-    norm: f64,
-    /// Strip width for b = 1: Δη = 2/m.
-    d_eta: f64,
+    /// The strips of the unit ellipse.
+    strips: Strips,
     /// Treatment of the sliding zones.
     sliding: SlidingZone,
     /// Gauss nodes on [0, 1] for the sliding-zone corrections, in decreasing
@@ -210,19 +206,35 @@ struct StripSums {
 }
 
 /// The strips of a unit ellipse cut across the lateral axis, as FastSim_A
-/// and FastSim_SA integrate over them: per strip its centre e ∈ (−1, 1) and
-/// half-length √(1 − e²); the normalization Σ (half-length)³ · (4/3) · Δe
-/// (→ π/2 as the strips get finer); and the strip width Δe = 2/strips.
-pub(super) fn strip_grid(strips: usize) -> (Vec<(f64, f64)>, f64, f64) {
-    let mf = strips as f64;
-    let strip_geom: Vec<(f64, f64)> = (0..strips)
-        .map(|j| {
-            let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
-            (e, (1.0 - e * e).max(0.0).sqrt())
-        })
-        .collect();
-    let norm = strip_geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
-    (strip_geom, norm, 2.0 / mf)
+/// and FastSim_SA integrate over them.
+#[derive(Debug, Clone)]
+pub(super) struct Strips {
+    /// Per strip: (η = y/b at the strip centre, √(1 − η²) = a_y/a).
+    pub(super) geom: Vec<(f64, f64)>,
+    /// Σ (4/3)(1 − η²)^(3/2)·Δη: the strips' bound integral for a = b = 1
+    /// (→ π/2 as the strips get finer).
+    pub(super) norm: f64,
+    /// Strip width for b = 1: Δη = 2/strips.
+    pub(super) d_eta: f64,
+}
+
+impl Strips {
+    /// `strips` strips of equal width.
+    pub(super) fn new(strips: usize) -> Strips {
+        let mf = strips as f64;
+        let geom: Vec<(f64, f64)> = (0..strips)
+            .map(|j| {
+                let e = -1.0 + (j as f64 + 0.5) * 2.0 / mf;
+                (e, (1.0 - e * e).max(0.0).sqrt())
+            })
+            .collect();
+        let norm = geom.iter().map(|&(_, s)| s * s * s).sum::<f64>() * (4.0 / 3.0) * 2.0 / mf;
+        Strips {
+            geom,
+            norm,
+            d_eta: 2.0 / mf,
+        }
+    }
 }
 
 impl FastsimA {
@@ -233,11 +245,8 @@ impl FastsimA {
                 "FastSim_A number of strips must be in 1..={MAX_STRIPS}, got {strips}"
             )));
         }
-        let (strip_geom, norm, d_eta) = strip_grid(strips);
         Ok(Self {
-            strip_geom,
-            norm,
-            d_eta,
+            strips: Strips::new(strips),
             sliding: SlidingZone::Continuation,
             nodes: Vec::new(),
         })
@@ -294,9 +303,9 @@ impl FastsimA {
     /// turns much take the closed form (with a logarithm) in a last pass.
     #[inline]
     fn eval(&self, p: &ContactPatch, c: &Creepages, fl: &Flexibilities) -> CreepForces {
-        let dy = self.d_eta * p.b;
+        let dy = self.strips.d_eta * p.b;
         // Bound g = K(aⱼ² − x²) with K such that the strips carry exactly μN.
-        let kk = p.mu * p.n / (self.norm * p.a * p.a * p.a * p.b);
+        let kk = p.mu * p.n / (self.strips.norm * p.a * p.a * p.a * p.b);
         let bb = c.eta * fl.inv_l2;
         let cc = 0.5 * c.phi * fl.inv_l3;
         let alpha = kk * kk - cc * cc;
@@ -315,8 +324,8 @@ impl FastsimA {
         // Full chunks of 8 lanes, the rest in chunks of 2 (a dummy lane of zero
         // length if odd): every lane computed is a strip.
         let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
-        let n8 = self.strip_geom.len() / 8 * 8;
-        for chunk in self.strip_geom[..n8].chunks(8) {
+        let n8 = self.strips.geom.len() / 8 * 8;
+        for chunk in self.strips.geom[..n8].chunks(8) {
             let (x, y, m) = chunk_sums::<8>(chunk, &k);
             fx += x;
             fy += y;
@@ -326,14 +335,14 @@ impl FastsimA {
         // continuation direction is exact).
         let correct = !self.nodes.is_empty() && cc != 0.0;
         if correct {
-            for chunk in self.strip_geom[..n8].chunks(8) {
+            for chunk in self.strips.geom[..n8].chunks(8) {
                 let (x, y, m) = chunk_corrections::<8>(chunk, &k, self.sliding, &self.nodes);
                 fx += x;
                 fy += y;
                 mz += m;
             }
         }
-        for chunk in self.strip_geom[n8..].chunks(2) {
+        for chunk in self.strips.geom[n8..].chunks(2) {
             let (x, y, m) = chunk_sums::<2>(chunk, &k);
             fx += x;
             fy += y;

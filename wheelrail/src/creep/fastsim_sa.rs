@@ -34,7 +34,7 @@
 //! `creep` (creepages to 6e-3, mostly sliding) 10 × 10 costs as FASTSIM's
 //! (2.2 million evaluations per second each).
 
-use super::fastsim_a::{StripConsts, adhesion_boundary, adhesion_zone, strip_grid};
+use super::fastsim_a::{StripConsts, Strips, adhesion_boundary, adhesion_zone};
 use super::{ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, Flexibilities, validate};
 
 /// Largest number of strips or elements per strip accepted.
@@ -44,12 +44,8 @@ const MAX_DIVISIONS: usize = 100_000;
 /// the sliding zones.
 #[derive(Debug, Clone)]
 pub struct FastsimSa {
-    /// Per strip: (η = y/b at the strip centre, √(1 − η²) = a_y/a).
-    strip_geom: Vec<(f64, f64)>,
-    /// Σ (4/3)(1 − η²)^(3/2)·Δη: the strips' bound integral for a = b = 1.
-    norm: f64,
-    /// Strip width for b = 1: Δη = 2/m.
-    d_eta: f64,
+    /// The strips of the unit ellipse.
+    strips: Strips,
     /// FASTSIM elements per strip, `n`.
     elements: usize,
 }
@@ -65,18 +61,15 @@ impl FastsimSa {
                 )));
             }
         }
-        let (strip_geom, norm, d_eta) = strip_grid(strips);
         Ok(Self {
-            strip_geom,
-            norm,
-            d_eta,
+            strips: Strips::new(strips),
             elements,
         })
     }
 
     /// Inputs validated, `N > 0`, `μ > 0`.
     fn eval(&self, p: &ContactPatch, c: &Creepages, fl: &Flexibilities) -> CreepForces {
-        let kk = p.mu * p.n / (self.norm * p.a * p.a * p.a * p.b);
+        let kk = p.mu * p.n / (self.strips.norm * p.a * p.a * p.a * p.b);
         let bb = c.eta * fl.inv_l2;
         let cc = 0.5 * c.phi * fl.inv_l3;
         let k = StripConsts {
@@ -96,7 +89,7 @@ impl FastsimSa {
         // march of each strip is a loop-carried dependency (traction → bound
         // → traction); lanes past their own element count get weight 0.
         const LANES: usize = 4;
-        for chunk in self.strip_geom.chunks(LANES) {
+        for chunk in self.strips.geom.chunks(LANES) {
             let mut y = [0.0; LANES];
             let mut a2 = [0.0; LANES];
             let mut a_ = [0.0; LANES];
@@ -164,7 +157,7 @@ impl FastsimSa {
                 mz += sm[l] - y[l] * sx[l];
             }
         }
-        let dy = self.d_eta * p.b;
+        let dy = self.strips.d_eta * p.b;
         CreepForces {
             fx: -fx * dy,
             fy: -fy * dy,
