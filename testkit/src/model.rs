@@ -31,12 +31,14 @@ pub fn all_mechanisms() -> Vec<Model> {
 /// Every bundled vehicle model (`models/vehicles/*.ron`, by file name; the
 /// subsystem component files in subfolders are covered through the
 /// vehicles), then the component wheelset with independently rotating wheels,
-/// which no vehicle uses yet, and the coupler models of trains
-/// (`models/vehicles/couplers/*.ron`).
+/// which no vehicle uses yet, the coupler models of trains
+/// (`models/vehicles/couplers/*.ron`) and the freight car
+/// (`models/vehicles/freight/freight_car.ron`).
 pub fn all_vehicles() -> Vec<Model> {
     let mut paths = model_files("vehicles");
     paths.push(model_path("vehicles/components/wheelset_s1002_irw.ron"));
     paths.extend(model_files("vehicles/couplers"));
+    paths.push(model_path("vehicles/freight/freight_car.ron"));
     paths.iter().map(|p| load(p)).collect()
 }
 

@@ -5,6 +5,7 @@ mod curving;
 mod dynamics;
 mod equations;
 mod equilibrium;
+mod freight;
 mod modes;
 mod plugins;
 mod symbolic;
