@@ -5,7 +5,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
     let names: Vec<String> = ["m", "k", "l_1"].iter().map(|s| s.to_string()).collect();

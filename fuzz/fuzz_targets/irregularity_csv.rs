@@ -6,7 +6,7 @@ use railmbs_track::{Irregularities, Irregularity, MeasuredIrregularity};
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
     if let Ok(m) = MeasuredIrregularity::from_csv_text(text, Path::new("fuzz.csv")) {

@@ -3,17 +3,13 @@
 //! (`subsystems/…`), which are then read, resolved and flattened too.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
-    let file = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/mechanisms/fuzz.ron"
-    ));
-    if let Ok(model) = railmbs_models::parse_model(text, file) {
+    let file = railmbs_fuzz::bundled_file("mechanisms");
+    if let Ok(model) = railmbs_models::parse_model(text, &file) {
         // The loaded model is usable: its parameter values resolve or say why.
         let _ = model.parameter_values(&[], &[]);
     }

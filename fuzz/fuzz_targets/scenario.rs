@@ -3,16 +3,12 @@
 //! files (`../vehicles/…`, `../tracks/…`), which are then loaded too.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
-    let file = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/scenarios/fuzz.ron"
-    ));
-    let _ = railmbs_models::parse_scenario(text, file);
-    let _ = railmbs_models::parse_train(text, file);
+    let file = railmbs_fuzz::bundled_file("scenarios");
+    let _ = railmbs_models::parse_scenario(text, &file);
+    let _ = railmbs_models::parse_train(text, &file);
 });

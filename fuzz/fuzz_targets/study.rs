@@ -2,17 +2,13 @@
 //! tables are the bundled ones), with their cases generated.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
-    let file = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/studies/fuzz.ron"
-    ));
-    if let Ok(study) = railmbs_study::Study::parse(text, file) {
+    let file = railmbs_fuzz::bundled_file("studies");
+    if let Ok(study) = railmbs_study::Study::parse(text, &file) {
         let _ = study.cases().len();
     }
 });

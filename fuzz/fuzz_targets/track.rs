@@ -2,17 +2,13 @@
 //! and built (alignment, grade, irregularities, gauge widening).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Some(text) = railmbs_fuzz::text(data) else {
         return;
     };
-    let file = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/tracks/fuzz.ron"
-    ));
-    if let Ok(track) = railmbs_models::parse_track(text, file) {
+    let file = railmbs_fuzz::bundled_file("tracks");
+    if let Ok(track) = railmbs_models::parse_track(text, &file) {
         // A built track answers for every position inside it.
         let l = track.length();
         for k in 0..=4 {
