@@ -49,6 +49,7 @@ pub use polach::Polach;
 pub use spec::{
     CREEP_LAW_SYNTAX, CreepLawSpec, FASTSIM_A_STRIPS, FASTSIM_DIVISIONS, ParseCreepLawError,
 };
+pub(crate) use strip::StripSolution;
 pub use strip::{STRIP_THEORY_STRIPS, StripTheory};
 
 pub use crate::creepage::Creepages;

@@ -339,6 +339,23 @@ impl Contact {
     }
 }
 
+/// One sample of the undeformed gap between a wheel and its rail
+/// ([`ContactGeometry::gap_samples`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GapSample {
+    /// Wheel profile coordinate `u` (m).
+    pub wheel_u: f64,
+    /// Lateral position of the rail point below it in the track frame (m, left positive).
+    pub rail_y: f64,
+    /// Vertical gap (m) at wheelset height `z = 0` (negative: interpenetration).
+    pub gap: f64,
+    /// Rolling radius of the wheel at this point (m).
+    pub rolling_radius: f64,
+    /// Inclination of the rail surface there (rad), the contact angle of a
+    /// contact at this point, same sign convention as [`Contact::contact_angle`].
+    pub contact_angle: f64,
+}
+
 /// The contacts of one wheel: one, or two in two-point contact (ordered from the field side
 /// to the flange, i.e. the tread contact first).
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -702,6 +719,70 @@ impl ContactGeometry {
                 roll,
             }),
         }
+    }
+
+    /// The vertical distance between wheel `k` (0 left, 1 right) and its rail
+    /// sampled along the whole wheel profile every `step` (m) of the wheel
+    /// coordinate `u`, for lateral shift `y` (m) and roll `roll` (rad),
+    /// wheelset height `z = 0`: the undeformed gap function that non-elliptic
+    /// contact models ([`crate::kik_piotrowski`]) cut into strips. Samples
+    /// where the rail does not exist below the wheel are left out; they are
+    /// ordered by the wheel coordinate, from the flange to the field side.
+    pub fn gap_samples(
+        &self,
+        k: usize,
+        y: f64,
+        roll: f64,
+        step: f64,
+    ) -> Result<Vec<GapSample>, GeometryError> {
+        if k > 1 {
+            return Err(invalid("wheel index", format!("must be 0 or 1, got {k}")));
+        }
+        check_positive("gap sampling step", step)?;
+        if !(y.is_finite() && roll.is_finite()) {
+            return Err(invalid(
+                "wheelset position",
+                format!("lateral shift {y} and roll {roll} must be finite"),
+            ));
+        }
+        let s = &self.sides[k];
+        let ys = s.sign * y;
+        let (ss, cs) = (s.sign * roll).sin_cos();
+        let (u0, u1) = s.wheel.range();
+        let n = ((u1 - u0) / step).ceil() as usize;
+        if n > 10_000_000 {
+            return Err(invalid(
+                "gap sampling step",
+                format!("{step} m gives more than 10^7 samples"),
+            ));
+        }
+        let (mut wseg, mut rseg) = (0, 0);
+        let mut out = Vec::with_capacity(n + 1);
+        for i in 0..=n {
+            let u = (u0 + i as f64 * step).min(u1);
+            let Some(h) = s.wheel.height_hinted(u, &mut wseg) else {
+                continue;
+            };
+            let Some((gap, v)) = self.distance(s, ys, cs, ss, u, h, &mut rseg) else {
+                continue;
+            };
+            let Some(r) = s.rail.eval(v) else { continue };
+            out.push(GapSample {
+                wheel_u: u,
+                rail_y: s.sign * (s.rail_origin + v),
+                gap,
+                rolling_radius: s.radius - h,
+                contact_angle: r.slope.atan(),
+            });
+        }
+        if out.is_empty() {
+            return Err(GeometryError::NoContact {
+                side: if k == 0 { "left" } else { "right" },
+                y,
+                roll,
+            });
+        }
+        Ok(out)
     }
 
     /// Golden-section refinement of a minimum of the vertical distance in `[a, b]`.

@@ -9,6 +9,8 @@
 //!   contact, tables over lateral shift and roll;
 //! - [`conicity`]: equivalent conicity by EN 15302;
 //! - [`hertz`]: Hertzian contact ellipse, approach, pressure;
+//! - [`kik_piotrowski`]: non-elliptic multi-patch contact by the modified
+//!   Kik–Piotrowski method (virtual penetration, strips);
 //! - [`creepage`]: creepages and spin from body velocities;
 //! - [`creep`]: creep-force laws (Kalker linear, Mueller (Pogorelov 2005), Kalker-saturated
 //!   Mueller, FASTSIM, FastSim_SA, FastSim_A, Polach);
@@ -29,6 +31,7 @@ pub mod elastic_rail;
 pub mod geometry;
 pub mod hertz;
 pub mod kalker;
+pub mod kik_piotrowski;
 pub mod profile;
 
 /// `x` as written for a reader in a message: plain between 10⁻⁴ and 10⁶ (and

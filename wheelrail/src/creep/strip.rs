@@ -44,6 +44,7 @@
 //! strip.
 
 use super::{ContactPatch, CreepError, CreepForces, CreepLaw, Creepages, validate};
+use crate::kalker::KalkerCoefficients;
 use std::f64::consts::PI;
 
 /// Default number of strips of [`StripTheory`] (`strip` on the command line).
@@ -98,37 +99,82 @@ impl CreepLaw for StripTheory {
             return Ok(CreepForces::default());
         }
         let (a, b) = (p.a, p.b);
-        let rba = (b / a).sqrt();
+        let sol = StripSolution::new(a, b, p.g, &k, c);
         let mu_p0 = p.mu * 3.0 * p.n / (2.0 * PI * a * b);
-        // Per-strip normalization, times 1/cos θ: 2 G C/(π² μ p₀).
-        let nx = 2.0 * p.g * k.c11 / (PI * PI * mu_p0);
-        let ny = 2.0 * p.g * k.c22 / (PI * PI * mu_p0);
+        let w0 = b * self.d_theta;
+        let mut f = CreepForces::default();
+        for &(s, co) in &self.strips {
+            // Hertz strip: y = b sin θ, l = a cos θ, p₀(y) = p₀ cos θ, width b cos θ Δθ.
+            sol.add_strip(&mut f, c, b * s, a * co, mu_p0 * co, w0 * co);
+        }
+        Ok(f)
+    }
+}
+
+/// The strip solution of the module documentation for one patch: the
+/// calibration constants from the semi-axes `a`, `b` (m) of the patch's
+/// ellipse (for a non-elliptic patch, its equivalent ellipse: the linear
+/// limit is then Kalker's for that ellipse), and the per-strip force. The one
+/// home of the strip solution: [`StripTheory`] cuts a Hertz ellipse into
+/// strips, [`crate::kik_piotrowski`] a non-elliptic patch.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StripSolution {
+    /// 2 G C11/π², 2 G C22/π² (Pa): times the creepage over μp₀(y) they give `s`.
+    cx: f64,
+    cy: f64,
+    /// λ of the lateral lever arm.
+    lambda: f64,
+    /// κφ (1/m): the longitudinal spin slip per unit y.
+    kphi: f64,
+    /// Lateral creepage from spin per l² (1/m²).
+    spin_eta: f64,
+}
+
+impl StripSolution {
+    /// Constants for the ellipse `a`, `b` (m), shear modulus `g` (Pa),
+    /// Kalker's coefficients `k` of that ellipse and the creepages `c`.
+    #[inline]
+    pub(crate) fn new(a: f64, b: f64, g: f64, k: &KalkerCoefficients, c: &Creepages) -> Self {
+        let rba = (b / a).sqrt();
         let lambda = 0.75 * PI * k.c23 / k.c22 * rba;
         let kappa = 4.0 / k.c11 * (a / b) * (k.c33 + 64.0 * lambda / (45.0 * PI) * k.c23 / rba);
-        // Lateral creepage from spin per l²: (4/3)(C23/C22)√(b/a) φ/a.
-        let spin_eta = 4.0 / 3.0 * k.c23 / k.c22 * rba * c.phi / a;
-        let kphi = kappa * c.phi;
-        // Force per unit width μp₀(y)(π/2)l(1 − α²) times the width b cos θ Δθ:
-        // μp₀ (π/2) a b Δθ · cos³θ (1 − α²).
-        let f0 = mu_p0 * 0.5 * PI * a * b * self.d_theta;
-        let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
-        for &(s, co) in &self.strips {
-            let (y, l) = (b * s, a * co);
-            let inv_co = 1.0 / co;
-            let sx = nx * inv_co * (c.xi - kphi * y);
-            let sy = ny * inv_co * (c.eta + spin_eta * l * l);
-            let sn = sx.hypot(sy);
-            if sn == 0.0 {
-                continue;
-            }
-            let alpha = (1.0 - sn).max(0.0);
-            let f = f0 * co * co * co * (1.0 - alpha * alpha) / sn;
-            let (sfx, sfy) = (-f * sx, -f * sy);
-            let xbar = -lambda * l * alpha * alpha / (1.0 + alpha);
-            fx += sfx;
-            fy += sfy;
-            mz += xbar * sfy - y * sfx;
+        Self {
+            cx: 2.0 * g * k.c11 / (PI * PI),
+            cy: 2.0 * g * k.c22 / (PI * PI),
+            lambda,
+            kphi: kappa * c.phi,
+            // (4/3)(C23/C22)√(b/a) φ/a
+            spin_eta: 4.0 / 3.0 * k.c23 / k.c22 * rba * c.phi / a,
         }
-        Ok(CreepForces { fx, fy, mz })
+    }
+
+    /// Adds to `f` the force of one strip at lateral position `y` (m, from
+    /// the point the creepages `c` refer to), half-length `l` (m), peak
+    /// pressure times friction `mu_p0` (Pa, > 0) and width `w` (m): μp₀(π/2)lw(1 − α²)
+    /// along −s/|s| (module documentation), its moment about that point.
+    #[inline]
+    pub(crate) fn add_strip(
+        &self,
+        f: &mut CreepForces,
+        c: &Creepages,
+        y: f64,
+        l: f64,
+        mu_p0: f64,
+        w: f64,
+    ) {
+        let inv = 1.0 / mu_p0;
+        let sx = self.cx * inv * (c.xi - self.kphi * y);
+        let sy = self.cy * inv * (c.eta + self.spin_eta * l * l);
+        let sn = sx.hypot(sy);
+        if sn == 0.0 {
+            return;
+        }
+        let alpha = (1.0 - sn).max(0.0);
+        let force = mu_p0 * 0.5 * PI * l * w * (1.0 - alpha * alpha) / sn;
+        let (sfx, sfy) = (-force * sx, -force * sy);
+        let xbar = -self.lambda * l * alpha * alpha / (1.0 + alpha);
+        f.fx += sfx;
+        f.fy += sfy;
+        f.mz += xbar * sfy - y * sfx;
     }
 }

@@ -10,6 +10,7 @@ mod exact_theory;
 mod fastsim_sa;
 mod geometry_contact;
 mod hertz;
+mod kik_piotrowski;
 mod mueller;
 mod polach;
 mod profile_reading;
