@@ -50,7 +50,24 @@
 //! **Simplifications** (stated): the gap is taken at `x = 0` with the
 //! longitudinal curvature of the wheel only (no yaw); each patch is planar at
 //! its deepest point's contact angle; the vertical force of a patch is
-//! `N cos γ` (normal force only, as for the frictionless normal problem).
+//! `N cos γ` (normal force only, as for the frictionless normal problem); a
+//! run of interpenetration whose reduced region falls apart stays one patch
+//! (its deepest point's); strips are the gap samples (their lateral spacing,
+//! e.g. 0.1 mm, is the strip width).
+//!
+//! **Accuracy** (tests in `tests/integration/kik_piotrowski.rs`): exact for
+//! a sphere with ε = 1/2; for constant curvatures with ε = 0.55 semi-axes
+//! within 20 %, area within 11 %, peak pressure within 10 % of Hertz for
+//! B/A from 0.2 to 5; against CONTACT for S1002/UIC60: area within 8 % and
+//! peak pressure within 9 % on the tread, 18 % and 19 % at the flange root,
+//! but +50 % and −33 % on the flange flank, where the curvature across the
+//! patch is ~100 times that along it and the virtual-penetration ellipse's
+//! axis ratio `√(A/B)` is far from Hertz's (no correction of it here).
+//!
+//! **Cost** (criterion, `benches/kik_piotrowski.rs`): per wheel, tens to a
+//! few hundred times Hertz with the 10-strip law, growing with the number of
+//! strips (the Boussinesq sum is 8 kernel evaluations per strip); the gap
+//! sampling across the whole profile costs as much again.
 
 use crate::creep::{ContactPatch, CreepError, CreepForces, Creepages, StripSolution, validate};
 use crate::geometry::GapSample;
@@ -64,8 +81,8 @@ const GL8: [(f64, f64); 8] = [
     (0.019_855_071_751_231_856, 0.050_614_268_145_188_13),
     (0.101_666_761_293_186_63, 0.111_190_517_226_687_24),
     (0.237_233_795_041_835_5, 0.156_853_322_938_943_64),
-    (0.408_282_678_752_175_1, 0.181_341_891_689_180_99),
-    (0.591_717_321_247_824_9, 0.181_341_891_689_180_99),
+    (0.408_282_678_752_175_1, 0.181_341_891_689_181),
+    (0.591_717_321_247_825, 0.181_341_891_689_181),
     (0.762_766_204_958_164_5, 0.156_853_322_938_943_64),
     (0.898_333_238_706_813_4, 0.111_190_517_226_687_24),
     (0.980_144_928_248_768_2, 0.050_614_268_145_188_13),
@@ -350,7 +367,15 @@ impl KikPiotrowski {
                 let k = if x == 0.0 {
                     0.0
                 } else {
-                    (((d + 0.5 * w) / x).asinh() - ((d - 0.5 * w) / x).asinh()) / w
+                    // asinh(D₁/x) − asinh(D₂/x) as one logarithm, D₁ = d + w/2,
+                    // D₂ = d − w/2 (for D₂ < 0 as asinh(D₁/x) + asinh(|D₂|/x),
+                    // without cancellation)
+                    let (d1, d2) = (d + 0.5 * w, d - 0.5 * w);
+                    let x2 = x * x;
+                    let e1 = d1 + (d1 * d1 + x2).sqrt();
+                    let e2 = d2.abs() + (d2 * d2 + x2).sqrt();
+                    let ratio = if d2 >= 0.0 { e1 / e2 } else { e1 * e2 / x2 };
+                    ratio.ln() / w
                 };
                 // dx = l cos θ dθ, dθ = π t dt; both halves of the strip.
                 acc += wt * cs * k * l * cs * PI * t;
