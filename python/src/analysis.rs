@@ -39,7 +39,7 @@ pub(crate) enum Engines<'a> {
     /// The numeric-iterative engine of the model.
     Numeric(&'a Model),
     /// The model's compiled plugin, loaded once.
-    Symbolic(Plugin),
+    Symbolic(Box<Plugin>),
 }
 
 impl<'a> Engines<'a> {
@@ -65,7 +65,7 @@ impl<'a> Engines<'a> {
                     }
                 };
                 Plugin::load_for(&path, model)
-                    .map(Self::Symbolic)
+                    .map(|p| Self::Symbolic(Box::new(p)))
                     .map_err(|e| e.to_string())
             }
         }
@@ -75,7 +75,7 @@ impl<'a> Engines<'a> {
     pub(crate) fn make(&self) -> Box<dyn Equations> {
         match self {
             Self::Numeric(m) => Box::new(NumericEquations::new(m)),
-            Self::Symbolic(p) => Box::new(PluginEquations::new(p.clone())),
+            Self::Symbolic(p) => Box::new(PluginEquations::new((**p).clone())),
         }
     }
 }
