@@ -9,6 +9,14 @@ Run a scenario in process, with the numbers ``umsim run`` writes::
     r = sc.run(engine="symbolic")
     r["time"], r.columns, r.summary, r.to_pandas()
 
+The analyses (static equilibrium, linear modes and the root locus with the
+linear critical speed, the nonlinear critical speed, quasi-static curving)
+are methods of :class:`Scenario` whose results are in
+:mod:`railmbs.analysis`::
+
+    eq = sc.equilibrium()              # state and wheel loads
+    sc.modes(speed=[20, 40, 60]).critical_speed
+
 The wheel–rail contact functions over numpy arrays are in
 :mod:`railmbs.contact`; parameter studies (the study files of ``umsim
 study``, on a local pool or a Dask cluster) in :mod:`railmbs.study`.
@@ -19,9 +27,10 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Tuple, Union
 
-from . import contact, errors, study
+from . import analysis, contact, errors, study
 from ._railmbs import CREEP_LAW_SYNTAX, Model, Scenario
 from .errors import (
+    AnalysisError,
     ContactError,
     ModelError,
     PluginError,
@@ -32,6 +41,7 @@ from .errors import (
 from .result import RunResult
 
 __all__ = [
+    "AnalysisError",
     "CREEP_LAW_SYNTAX",
     "ContactError",
     "Model",
@@ -42,6 +52,7 @@ __all__ = [
     "Scenario",
     "SimulationError",
     "StudyError",
+    "analysis",
     "contact",
     "errors",
     "run",

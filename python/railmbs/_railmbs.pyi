@@ -5,11 +5,12 @@ Units are SI throughout; see the docstrings (``help(railmbs.Scenario)``).
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Set, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Set, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
+from .analysis import Bifurcation, CriticalSpeed, Curving, Equilibrium, Locus, Modes
 from .result import RunResult
 
 _Path = Union[str, PathLike]
@@ -106,6 +107,63 @@ class Scenario:
         end; an exception it raises, or Ctrl-C, stops the run and is re-raised.
         Raises ``ModelError``, ``PluginError``, ``SimulationError`` (with the
         partial ``result``)."""
+    def equilibrium(self, engine: str = "numeric", plugin: Optional[_Path] = None) -> Equilibrium:
+        """The static (steady) equilibrium at the start (``umsim
+        equilibrium``): state ``q`` (m, rad), ``v`` (m/s, rad/s), each
+        coordinate's role and the wheel loads Q, Y (N). GIL released.
+        Raises ``AnalysisError`` (no equilibrium), ``ModelError``,
+        ``PluginError``; ``ValueError`` for a train."""
+    def modes(
+        self,
+        speed: Union[None, float, Sequence[float]] = None,
+        parameter: Optional[str] = None,
+        values: Optional[Sequence[float]] = None,
+        engine: str = "numeric",
+        plugin: Optional[_Path] = None,
+    ) -> Union[Modes, Locus]:
+        """Linear modes at the steady state (``umsim modes``): frequency
+        (Hz), damping ratio, name and shape of each. ``speed`` ``None`` (the
+        scenario's) or a number (m/s): :class:`Modes`; a sequence of speeds
+        (m/s): the root locus, a :class:`Locus` with ``critical_speed`` (m/s,
+        the linear critical speed); ``parameter`` with ``values``: a locus
+        over a model parameter (``umsim modes --sweep``). GIL released.
+        Raises ``AnalysisError``, ``ModelError``, ``PluginError``, ``ValueError``."""
+    def critical_speed(
+        self,
+        bifurcation: Optional[Sequence[float]] = None,
+        signals: Optional[Sequence[str]] = None,
+        window: float = 1.0,
+        threshold: float = 1e-3,
+        on: float = 4e-3,
+        relative: float = 0.5,
+        hold: float = 6.0,
+        ramp: float = 0.5,
+        measure: Optional[float] = None,
+        engine: str = "numeric",
+        plugin: Optional[_Path] = None,
+        progress: Optional[Callable[[float, float], Any]] = None,
+    ) -> Union[CriticalSpeed, Bifurcation]:
+        """The nonlinear critical speed (``umsim critical-speed``): a
+        decelerating run's limit cycle (window s; threshold and on m) →
+        :class:`CriticalSpeed` (speed m/s); with ``bifurcation`` (speeds,
+        m/s; plateaus of ``hold`` s, ramps of ``ramp`` s, amplitude over the
+        last ``measure`` s) → :class:`Bifurcation`. GIL released; progress
+        and Ctrl-C as for :meth:`run`. Raises ``AnalysisError``,
+        ``ModelError``, ``PluginError``, ``ValueError``."""
+    def curving(
+        self,
+        radius: float,
+        speed: Union[float, Sequence[float]],
+        cant: float = 0.0,
+        engine: str = "numeric",
+        plugin: Optional[_Path] = None,
+    ) -> Curving:
+        """Quasi-static curving (``umsim curving``) on a circular curve of
+        ``radius`` m (positive left) and ``cant`` m at ``speed`` m/s (or a
+        sweep over a sequence): per wheelset lateral position (m), angle of
+        attack (rad) and contact outputs; per wheel Q, Y (N), Y/Q. GIL
+        released. Raises ``ValueError`` (bad curve), ``AnalysisError``,
+        ``ModelError``, ``PluginError``."""
 
 _Row = List[str]
 

@@ -61,6 +61,24 @@ class SimulationError(RailmbsError, RuntimeError):
         self.result = result
 
 
+class AnalysisError(RailmbsError, RuntimeError):
+    """An analysis (equilibrium, modes, critical speed, curving) found no
+    result: no equilibrium within the iterations (the message names the
+    residual and the coordinates carrying it), a failed linearization or
+    eigendecomposition, no steady curving state, or a scenario the analysis
+    cannot use (no track for curving, say). The message is the one ``umsim``
+    prints.
+
+    Attributes:
+        file: the scenario file the message names (``None`` if none).
+    """
+
+    def __init__(self, message: str, file: Optional[str] = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.file = file
+
+
 class PluginError(RailmbsError, RuntimeError):
     """The symbolic plugin could not be generated, compiled or loaded."""
 

@@ -107,3 +107,16 @@ pub fn simulation_error(
     }
     new_error(py, "SimulationError", message, &attrs)
 }
+
+/// `AnalysisError(message, file=…)`: an analysis found no result (no
+/// equilibrium, a failed eigendecomposition, no steady curving state, a
+/// scenario it cannot use); `file` is the scenario file it names.
+pub fn analysis_error(py: Python<'_>, message: &str, file: Option<String>) -> PyErr {
+    let mut attrs = Vec::new();
+    if let Some(f) = file
+        && let Ok(f) = f.into_pyobject(py)
+    {
+        attrs.push(("file", f.into_any()));
+    }
+    new_error(py, "AnalysisError", message, &attrs)
+}

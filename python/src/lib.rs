@@ -14,6 +14,7 @@
 
 use pyo3::prelude::*;
 
+pub mod analysis;
 pub mod contact;
 pub mod errors;
 pub mod sim;

@@ -181,6 +181,52 @@ impl Scenario {
     }
 }
 
+impl Scenario {
+    /// The single scenario and its model (with the creep law of
+    /// `set_creep_law`) for the analysis `what`; a train is a `ValueError`.
+    fn analysis_inputs(
+        &mut self,
+        py: Python<'_>,
+        what: &str,
+    ) -> PyResult<(railmbs_models::Scenario, Arc<railmbs_models::Model>)> {
+        let scenario = self.single(what)?.clone();
+        let mut model = self.model_arc(py)?;
+        if let Some((_, law)) = &self.creep {
+            let m = Arc::make_mut(&mut model);
+            if m.set_creep_law(law) == 0 {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "set_creep_law: model \"{}\" has no wheel–rail element",
+                    m.name
+                )));
+            }
+        }
+        Ok((scenario, model))
+    }
+}
+
+/// Speeds (m/s) from Python: one number or a sequence of numbers.
+enum SpeedArg {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+fn speed_arg(value: &Bound<'_, PyAny>, what: &str) -> PyResult<SpeedArg> {
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(SpeedArg::One(x));
+    }
+    value
+        .extract::<Vec<f64>>()
+        .map(SpeedArg::Many)
+        .map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "{what} is a speed in m/s or a sequence of speeds, got {}",
+                value
+                    .repr()
+                    .map_or_else(|_| "?".to_string(), |r| r.to_string())
+            ))
+        })
+}
+
 /// A parameter value from Python: a number (written in Rust's shortest
 /// round-trip form, so it reads back as the same double) or expression text.
 fn value_text(value: &Bound<'_, PyAny>) -> PyResult<String> {
@@ -219,19 +265,19 @@ enum Failure {
 
 /// The progress callback and the stop flag of a run, shared with the run's
 /// thread.
-struct Watch<'a> {
-    progress: Option<&'a Py<PyAny>>,
-    t_end: f64,
-    stop: Arc<AtomicBool>,
+pub(crate) struct Watch<'a> {
+    pub(crate) progress: Option<&'a Py<PyAny>>,
+    pub(crate) t_end: f64,
+    pub(crate) stop: Arc<AtomicBool>,
     /// The exception that stopped the run (KeyboardInterrupt, or the
     /// callback's own).
-    raised: Mutex<Option<PyErr>>,
+    pub(crate) raised: Mutex<Option<PyErr>>,
 }
 
 impl Watch<'_> {
     /// Called by the runner now and then (at most every 100 ms): Python's
     /// signal handlers (Ctrl-C raises KeyboardInterrupt), then the callback.
-    fn tick(&self, t: f64) {
+    pub(crate) fn tick(&self, t: f64) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
@@ -247,7 +293,7 @@ impl Watch<'_> {
         });
     }
 
-    fn raised(&self) -> Option<PyErr> {
+    pub(crate) fn raised(&self) -> Option<PyErr> {
         self.raised.lock().expect("not poisoned").take()
     }
 }
@@ -557,6 +603,234 @@ impl Scenario {
         Ok(result)
     }
 
+    /// The static (steady) equilibrium at the scenario's start, as `umsim
+    /// equilibrium` (and `initial_state: Equilibrium`): a Newton solve with
+    /// every force element and the wheel–rail contact, the wheels' rolling
+    /// rates solved, coordinates without stiffness held. Returns a
+    /// `railmbs.analysis.Equilibrium`: the state `q` (m, rad), `v` (m/s,
+    /// rad/s), the role of each coordinate and the wheel loads Q and lateral
+    /// forces Y (N) of every wheel. The GIL is released during the solve.
+    ///
+    /// Errors: `AnalysisError` (no equilibrium: the residual and the
+    /// coordinates carrying it), `ModelError`, `PluginError`; `ValueError`
+    /// for a train.
+    #[pyo3(signature = (engine = "numeric", plugin = None))]
+    fn equilibrium(
+        &mut self,
+        py: Python<'_>,
+        engine: &str,
+        plugin: Option<PathBuf>,
+    ) -> PyResult<Py<PyAny>> {
+        let engine = engine_of(engine, &plugin)?;
+        let (scenario, model) = self.analysis_inputs(py, "equilibrium")?;
+        crate::analysis::equilibrium(py, &scenario, &model, engine, plugin.as_deref())
+    }
+
+    /// The linear modes at the steady state, as `umsim modes`: the full
+    /// model (contact linearized at its actual geometry) linearized at its
+    /// equilibrium, the eigenvalues with damped and natural frequency (Hz),
+    /// damping ratio, mode name and normalized shape.
+    ///
+    /// `speed`: `None`, the scenario's own speed (`railmbs.analysis.Modes`);
+    /// a number (m/s), the modes at that constant speed; a sequence of
+    /// speeds (m/s), the root locus (`railmbs.analysis.Locus`, with
+    /// `critical_speed`: the linear critical speed, where the least damped
+    /// lateral mode's damping ratio first crosses zero, interpolated).
+    /// `parameter` with `values`: a locus over a model parameter (its own
+    /// unit) at the scenario's speed (or at `speed`, a number), as `umsim
+    /// modes --sweep`. The GIL is released during the computation.
+    ///
+    /// Errors: `AnalysisError` (no equilibrium, a failed
+    /// eigendecomposition), `ModelError`, `PluginError`, `ValueError`.
+    #[pyo3(signature = (speed = None, parameter = None, values = None, engine = "numeric", plugin = None))]
+    fn modes(
+        &mut self,
+        py: Python<'_>,
+        speed: Option<&Bound<'_, PyAny>>,
+        parameter: Option<String>,
+        values: Option<Vec<f64>>,
+        engine: &str,
+        plugin: Option<PathBuf>,
+    ) -> PyResult<Py<PyAny>> {
+        let engine = engine_of(engine, &plugin)?;
+        let speed = speed.map(|v| speed_arg(v, "speed")).transpose()?;
+        let bad = |m: String| Err(pyo3::exceptions::PyValueError::new_err(m));
+        let what = match (speed, parameter, values) {
+            (None, None, None) => crate::analysis::ModesOf::One(None),
+            (Some(SpeedArg::One(v)), None, None) => crate::analysis::ModesOf::One(Some(v)),
+            (Some(SpeedArg::Many(v)), None, None) => {
+                if v.is_empty() {
+                    return bad("modes: speed is an empty sequence".into());
+                }
+                crate::analysis::ModesOf::Speeds(v)
+            }
+            (s @ (None | Some(SpeedArg::One(_))), Some(p), Some(values)) => {
+                if values.is_empty() {
+                    return bad("modes: values is an empty sequence".into());
+                }
+                let v = match s {
+                    Some(SpeedArg::One(v)) => Some(v),
+                    _ => None,
+                };
+                crate::analysis::ModesOf::Parameter(p, values, v)
+            }
+            (Some(SpeedArg::Many(_)), Some(_), _) => {
+                return bad("modes: a parameter locus is at one speed, not at a sequence".into());
+            }
+            _ => return bad("modes: parameter and values go together".into()),
+        };
+        if let crate::analysis::ModesOf::One(Some(v))
+        | crate::analysis::ModesOf::Parameter(_, _, Some(v)) = &what
+            && !(v.is_finite() && *v >= 0.0)
+        {
+            return bad(format!("modes: speed {v} m/s must be finite and ≥ 0"));
+        }
+        if let crate::analysis::ModesOf::Speeds(v) = &what
+            && let Some(x) = v.iter().find(|x| !(x.is_finite() && **x >= 0.0))
+        {
+            return bad(format!("modes: speed {x} m/s must be finite and ≥ 0"));
+        }
+        let (scenario, model) = self.analysis_inputs(py, "modes")?;
+        crate::analysis::modes(py, &scenario, &model, engine, plugin.as_deref(), what)
+    }
+
+    /// The nonlinear critical speed, as `umsim critical-speed`.
+    ///
+    /// Without `bifurcation`: the scenario is a decelerating run (its
+    /// `speed_profile`) from a large disturbance; the lateral limit cycle
+    /// of `signals` (coordinate names; default the wheelsets' lateral
+    /// coordinates) is detected, its amplitude half the range over `window`
+    /// s, established from `on` m, died out below `threshold` m or below
+    /// `relative` times its largest amplitude. Returns a
+    /// `railmbs.analysis.CriticalSpeed` (`speed`, m/s, where the cycle died
+    /// out, or `None`; the run's `result`).
+    ///
+    /// With `bifurcation` (a sequence of speeds, m/s): one run at
+    /// constant-speed plateaus from the highest down, each `hold` s long
+    /// (the first twice), joined by ramps of `ramp` s, each starting from
+    /// the state the one before ended in; the amplitude over the last
+    /// `measure` s (default half a plateau) of each: a
+    /// `railmbs.analysis.Bifurcation`. `progress(t, t_end)` (s) as for
+    /// `run`; the GIL is released during the run.
+    ///
+    /// Errors: `AnalysisError` (bad settings, no track, no signal),
+    /// `ModelError`, `PluginError`.
+    #[pyo3(signature = (bifurcation = None, signals = None, window = 1.0, threshold = 1e-3, on = 4e-3, relative = 0.5, hold = 6.0, ramp = 0.5, measure = None, engine = "numeric", plugin = None, progress = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn critical_speed(
+        &mut self,
+        py: Python<'_>,
+        bifurcation: Option<Vec<f64>>,
+        signals: Option<Vec<String>>,
+        window: f64,
+        threshold: f64,
+        on: f64,
+        relative: f64,
+        hold: f64,
+        ramp: f64,
+        measure: Option<f64>,
+        engine: &str,
+        plugin: Option<PathBuf>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
+        use railmbs_runtime::analysis::critical::{DetectionSettings, Staircase};
+        let engine = engine_of(engine, &plugin)?;
+        let (scenario, model) = self.analysis_inputs(py, "critical_speed")?;
+        let detection = DetectionSettings {
+            relative,
+            on,
+            ..DetectionSettings::new(window, threshold)
+        };
+        detection
+            .check()
+            .map_err(pyo3::exceptions::PyValueError::new_err)?;
+        let plan = bifurcation.map(|speeds| {
+            let mut speeds = speeds;
+            // Run from the highest speed down.
+            speeds.sort_by(|a, b| b.total_cmp(a));
+            Staircase {
+                speeds,
+                first_hold: 2.0 * hold,
+                hold,
+                ramp,
+                measure: measure.unwrap_or(0.5 * hold),
+            }
+        });
+        if let Some(p) = &plan {
+            p.check().map_err(pyo3::exceptions::PyValueError::new_err)?;
+        }
+        let watch = Watch {
+            progress: progress.as_ref(),
+            t_end: plan.as_ref().map_or(scenario.end_time, Staircase::end_time),
+            stop: Arc::new(AtomicBool::new(false)),
+            raised: Mutex::new(None),
+        };
+        let options = crate::analysis::CriticalOptions {
+            signals: signals.unwrap_or_default(),
+            detection,
+            bifurcation: plan,
+        };
+        let out = crate::analysis::critical(
+            py,
+            &scenario,
+            &model,
+            engine,
+            plugin.as_deref(),
+            options,
+            &watch,
+        )?;
+        if let Some(cb) = &progress {
+            cb.call1(py, (watch.t_end, watch.t_end))?;
+        }
+        Ok(out)
+    }
+
+    /// The quasi-static curving solution, as `umsim curving`: the steady
+    /// state of the scenario's vehicle on a circular curve of `radius` m
+    /// (positive left, negative right) with `cant` m, at constant `speed`
+    /// (m/s, or a sequence of speeds: a sweep, each from the one before),
+    /// solved directly in the track-following frames with every force
+    /// element and the wheel–rail contact. Returns a
+    /// `railmbs.analysis.Curving`: per speed and wheelset the lateral
+    /// position (m), angle of attack (rad) and every contact output (Q, Y,
+    /// Y/Q, ΣY, creep forces, wear number…), per wheel Q, Y and Y/Q. The
+    /// GIL is released during the solve.
+    ///
+    /// Errors: `ValueError` (a bad curve), `AnalysisError` (no steady
+    /// state, no track), `ModelError`, `PluginError`.
+    #[pyo3(signature = (radius, speed, cant = 0.0, engine = "numeric", plugin = None))]
+    fn curving(
+        &mut self,
+        py: Python<'_>,
+        radius: f64,
+        speed: &Bound<'_, PyAny>,
+        cant: f64,
+        engine: &str,
+        plugin: Option<PathBuf>,
+    ) -> PyResult<Py<PyAny>> {
+        let engine = engine_of(engine, &plugin)?;
+        let speeds = match speed_arg(speed, "speed")? {
+            SpeedArg::One(v) => vec![v],
+            SpeedArg::Many(v) if !v.is_empty() => v,
+            SpeedArg::Many(_) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(
+                    "curving: speed is an empty sequence",
+                ));
+            }
+        };
+        let (scenario, model) = self.analysis_inputs(py, "curving")?;
+        crate::analysis::curving(
+            py,
+            &scenario,
+            &model,
+            engine,
+            plugin.as_deref(),
+            radius,
+            cant,
+            &speeds,
+        )
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Scenario({:?}{}, end_time={})",
@@ -579,7 +853,7 @@ fn run_error(py: Python<'_>, e: RunError) -> PyErr {
 
 /// The `railmbs.RunResult` of a run: the table's columns as numpy arrays
 /// (moved, not copied), the summary and the assessment table.
-fn run_result(py: Python<'_>, table: Table, s: &RunSummary) -> PyResult<Py<PyAny>> {
+pub(crate) fn run_result(py: Python<'_>, table: Table, s: &RunSummary) -> PyResult<Py<PyAny>> {
     let names = table.names().to_vec();
     let columns = PyList::empty(py);
     for c in table.into_columns() {

@@ -268,7 +268,16 @@ impl StudyEngine {
             values: Vec::new(),
         };
         let empty = |study: &Study| {
-            let n: usize = study.reductions.iter().map(|r| r.columns().len()).sum();
+            let n: usize = study
+                .reductions
+                .iter()
+                .map(|r| r.columns().len())
+                .sum::<usize>()
+                + study
+                    .analyses
+                    .iter()
+                    .map(|a| a.columns().len())
+                    .sum::<usize>();
             vec![Cell::Empty; n]
         };
         let finish = |mut r: CaseResult| {
@@ -285,6 +294,56 @@ impl StudyEngine {
                 return Ok(finish(result));
             }
         };
+        if study.time_run() {
+            self.time_run(study, case, &scenario, options, &mut result)?;
+        }
+        if result.status == CaseStatus::Ok && !study.analyses.is_empty() {
+            if options
+                .stop
+                .as_ref()
+                .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+            {
+                return Err(StudyError::Interrupted);
+            }
+            match self.analyses(study, &scenario) {
+                Ok(cells) => result.values.extend(cells),
+                Err(e) => {
+                    result.status = CaseStatus::Failed;
+                    result.error = Some(e);
+                }
+            }
+        }
+        if result.status == CaseStatus::Failed {
+            result.values = empty(study);
+        }
+        Ok(finish(result))
+    }
+
+    /// The cells of the study's analyses of the case scenario `scenario`
+    /// (a single vehicle: checked at load), each on fresh engines of the
+    /// study's plugin, sharing the study's contact tables.
+    fn analyses(&self, study: &Study, scenario: &StudyScenario) -> Result<Vec<Cell>, String> {
+        let StudyScenario::Single(s) = scenario else {
+            return Err("the analyses apply to a single-vehicle scenario".into());
+        };
+        let mut engine = || Ok(self.equations(study, 0));
+        let mut cells = Vec::new();
+        for a in &study.analyses {
+            cells.extend(a.cells(s, &study.models[0], &mut engine, &self.tables)?);
+        }
+        Ok(cells)
+    }
+
+    /// The time run of a case into `result` (its steps, time, status and
+    /// the run reductions' cells).
+    fn time_run(
+        &self,
+        study: &Study,
+        case: &Case,
+        scenario: &StudyScenario,
+        options: &CaseOptions,
+        result: &mut CaseResult,
+    ) -> Result<(), StudyError> {
         let mut series = options
             .series_dir
             .as_ref()
@@ -338,7 +397,6 @@ impl StudyEngine {
                     Some(e) => {
                         result.status = CaseStatus::Failed;
                         result.error = Some(e.to_string());
-                        result.values = empty(study);
                     }
                     None => result.values = reducer.cells(&summary.assessment),
                 }
@@ -353,10 +411,9 @@ impl StudyEngine {
                 }
                 result.status = CaseStatus::Failed;
                 result.error = Some(e.to_string());
-                result.values = empty(study);
             }
         }
-        Ok(finish(result))
+        Ok(())
     }
 }
 

@@ -1,5 +1,6 @@
 //! The study file: RON syntax, loading, validation with located errors.
 
+use crate::analysis::{Analysis, AnalysisKind};
 use crate::cases::{self, Case};
 use crate::reduce::{Reduction, ReductionKind, Window};
 use crate::series::SeriesFormat;
@@ -92,6 +93,39 @@ enum RawReduction {
         #[serde(default)]
         name: Option<String>,
     },
+    LeastDamping(NameArgs),
+    LinearCriticalSpeed(SpeedsArgs),
+    Curving(CurvingArgs),
+}
+
+/// The optional result name of an analysis.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NameArgs {
+    #[serde(default)]
+    name: Option<String>,
+}
+
+/// `LinearCriticalSpeed(speeds: (FROM, TO, STEP), name: …)`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpeedsArgs {
+    speeds: (f64, f64, f64),
+    #[serde(default)]
+    name: Option<String>,
+}
+
+/// `Curving(radius: R, cant: H, speed: Some(V), name: …)`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CurvingArgs {
+    radius: f64,
+    #[serde(default)]
+    cant: f64,
+    #[serde(default)]
+    speed: Option<f64>,
+    #[serde(default)]
+    name: Option<String>,
 }
 
 fn default_amplitude_window() -> f64 {
@@ -193,8 +227,12 @@ pub struct Study {
     pub case_source: CaseSource,
     /// The cases, in order (index = position).
     pub cases: Vec<Case>,
-    /// The reductions of every case.
+    /// The reductions of every case's time run.
     pub reductions: Vec<Reduction>,
+    /// The analyses of every case (`LeastDamping`, `LinearCriticalSpeed`,
+    /// `Curving` in the file's `reductions`), in the file's order; their
+    /// columns follow the run's reductions.
+    pub analyses: Vec<Analysis>,
     /// Whether each case's output is written as `series/<case id>.csv`
     /// (or `.parquet`, after `series_format`).
     pub time_series: bool,
@@ -346,7 +384,7 @@ impl Study {
             }
         };
         cases::check_variables(&variables, &set, &models, &scenario, &mut p);
-        let reductions = reductions(raw.reductions, &mut p);
+        let (reductions, analyses) = reductions(raw.reductions, &scenario, &mut p);
         let mut study = Study {
             source: path.to_path_buf(),
             scenario_text: raw.scenario,
@@ -360,6 +398,7 @@ impl Study {
             case_source,
             cases: Vec::new(),
             reductions,
+            analyses,
             time_series: raw.time_series,
             series_format: raw.series_format.unwrap_or_default(),
         };
@@ -411,7 +450,16 @@ impl Study {
         for r in &self.reductions {
             h.extend(r.columns());
         }
+        for a in &self.analyses {
+            h.extend(a.columns());
+        }
         h
+    }
+
+    /// Whether a case runs in time: when it has a run reduction or time
+    /// series, or no analysis (a study of analyses alone runs none).
+    pub fn time_run(&self) -> bool {
+        !self.reductions.is_empty() || self.time_series || self.analyses.is_empty()
     }
 
     /// The scenario of `case`: the study's scenario with the case's
@@ -433,10 +481,83 @@ pub(crate) fn value_text(v: &Value) -> String {
     }
 }
 
-fn reductions(raw: Vec<RawReduction>, p: &mut Problems) -> Vec<Reduction> {
+/// The run reductions and the analyses of the file's `reductions`.
+fn reductions(
+    raw: Vec<RawReduction>,
+    scenario: &StudyScenario,
+    p: &mut Problems,
+) -> (Vec<Reduction>, Vec<Analysis>) {
     let mut out = Vec::new();
+    let mut analyses = Vec::new();
     for r in raw {
         let (kind, args) = match r {
+            RawReduction::LeastDamping(NameArgs { name }) => {
+                analyses.push(Analysis::new(AnalysisKind::LeastDamping, name));
+                continue;
+            }
+            RawReduction::LinearCriticalSpeed(SpeedsArgs {
+                speeds: (from, to, step),
+                name,
+            }) => {
+                match railmbs_runtime::analysis::speed::speed_grid(from, to, step) {
+                    Ok(speeds) => analyses.push(Analysis::new(
+                        AnalysisKind::LinearCriticalSpeed { speeds },
+                        name,
+                    )),
+                    Err(e) => p.at(
+                        None,
+                        "speeds",
+                        "LinearCriticalSpeed",
+                        format!("speeds (FROM, TO, STEP): {e}"),
+                    ),
+                }
+                continue;
+            }
+            RawReduction::Curving(CurvingArgs {
+                radius,
+                cant,
+                speed,
+                name,
+            }) => {
+                let probe = railmbs_runtime::analysis::curving::Curve {
+                    radius,
+                    cant,
+                    speed: speed.unwrap_or(1.0),
+                };
+                let on_track = match scenario {
+                    StudyScenario::Single(s) => s.track.is_some(),
+                    StudyScenario::Train(_) => true,
+                };
+                if let Err(e) = probe.track() {
+                    let key = if e.starts_with("speed") {
+                        "speed"
+                    } else if e.starts_with("cant") {
+                        "cant"
+                    } else {
+                        "radius"
+                    };
+                    p.at(None, key, "Curving", e);
+                } else if !on_track {
+                    p.at(
+                        None,
+                        "radius",
+                        "Curving",
+                        "quasi-static curving needs a vehicle on a track: the scenario has no \
+                         `track`"
+                            .into(),
+                    );
+                } else {
+                    analyses.push(Analysis::new(
+                        AnalysisKind::Curving {
+                            radius,
+                            cant,
+                            speed,
+                        },
+                        name,
+                    ));
+                }
+                continue;
+            }
             RawReduction::Assessment => {
                 out.push(Reduction::new(ReductionKind::Assessment, None));
                 continue;
@@ -512,5 +633,21 @@ fn reductions(raw: Vec<RawReduction>, p: &mut Problems) -> Vec<Reduction> {
             args.name,
         ));
     }
-    out
+    if !analyses.is_empty() && matches!(scenario, StudyScenario::Train(_)) {
+        p.at(
+            None,
+            "reductions",
+            "reductions",
+            format!(
+                "{}: the analyses (LeastDamping, LinearCriticalSpeed, Curving) apply to a \
+                 single-vehicle scenario, not to a train",
+                analyses
+                    .iter()
+                    .map(|a| a.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    }
+    (out, analyses)
 }

@@ -153,6 +153,39 @@
 //!   established or one still goes on at the end of the run (it survives to
 //!   the lowest speed).
 //!
+//! ### Analyses
+//!
+//! Instead of (or besides) a time run, a case can be reduced by one of the
+//! runtime's analyses at the case's parameters and speed
+//! ([`railmbs_runtime::analysis`], the functions of `umsim modes` and `umsim
+//! curving`), written in `reductions` like the run's reductions:
+//!
+//! - `LeastDamping(name: Some("hunting"))` (or `LeastDamping()`): the least
+//!   damped lateral mode at the case's steady state and speed, as `umsim
+//!   modes` reports it; columns NAME (the damping ratio, 1), `NAME.f[Hz]`
+//!   (its damped frequency) and `NAME.mode` (its name). Default name
+//!   `least_damping`;
+//! - `LinearCriticalSpeed(speeds: (20.0, 80.0, 2.0))`: the root locus at the
+//!   speeds FROM, FROM + STEP, … TO (m/s; `umsim modes --speed
+//!   FROM:TO:STEP`) and the linear critical speed, where the least damped
+//!   lateral mode's damping ratio first crosses zero (m/s, empty when it does
+//!   not cross in the range). Default name `linear_critical_speed[m/s]`;
+//! - `Curving(radius: 300.0, cant: 0.1, speed: Some(20.0))`: the
+//!   quasi-static curving solution (`umsim curving`) on a circular curve of
+//!   radius m (positive left, negative right) and cant m (default 0), at
+//!   `speed` m/s (default: the case's speed); columns `NAME.YQ.max` and
+//!   `NAME.YQ.wheel` (the largest Y/Q of all wheels and which, `ELEMENT
+//!   left|right`), `NAME.sumY.max[N]` and `NAME.sumY.element` (largest
+//!   |ΣY|), `NAME.Q.max[N]`, `NAME.Q.min[N]`, `NAME.y.max[m]` and
+//!   `NAME.yaw.max[rad]` (the largest |lateral position| and |angle of
+//!   attack| of the wheelsets). Default name `curving`.
+//!
+//! Their columns follow those of the run's reductions, in the file's order.
+//! A study whose `reductions` are all analyses (and without `time_series`)
+//! runs no time simulation: `steps` and `t_end[s]` are 0. Analyses apply
+//! to a single vehicle (`Scenario(...)`), not to a train. An analysis that
+//! fails (no equilibrium, say) fails its case, with the message.
+//!
 //! ## The result table
 //!
 //! `results.csv`, one row per case: `index`, `case_id`, the variables,
@@ -164,6 +197,7 @@
 //! reductions. A failed case has empty reductions
 //! (values of a run cut short are not written as if fine) and its error.
 
+mod analysis;
 mod cases;
 mod engine;
 mod format;
@@ -172,6 +206,7 @@ mod reduce;
 mod series;
 mod store;
 
+pub use analysis::{Analysis, AnalysisKind};
 pub use cases::{Case, Overrides};
 pub use engine::{CaseOptions, CaseResult, CaseStatus, PluginBuilds, StudyEngine};
 pub use format::{CaseSource, EngineKind, Study, StudyScenario};

@@ -33,6 +33,31 @@ pub struct SpeedModes {
     pub seconds: [f64; 3],
 }
 
+/// The speeds FROM, FROM + STEP, … up to TO (m/s; TO included when it
+/// falls on the grid, to a millionth of a step): the speed ranges of
+/// `umsim modes --speed`, `umsim curving --speed` and the studies.
+///
+/// # Errors
+/// Not 0 ≤ FROM ≤ TO and STEP > 0 (all finite), or more than 10 000 speeds.
+pub fn speed_grid(from: f64, to: f64, step: f64) -> Result<Vec<f64>, String> {
+    if !(from.is_finite() && to.is_finite() && step.is_finite())
+        || step <= 0.0
+        || to < from
+        || from < 0.0
+    {
+        return Err(format!(
+            "({from}, {to}, {step}): need 0 ≤ FROM ≤ TO and STEP > 0 (m/s)"
+        ));
+    }
+    let count = ((to - from) / step + 1e-6).floor() as usize + 1;
+    if count > 10_000 {
+        return Err(format!(
+            "({from}, {to}, {step}) asks for {count} speeds (at most 10000)"
+        ));
+    }
+    Ok((0..count).map(|k| from + k as f64 * step).collect())
+}
+
 /// `scenario` run at the constant speed `speed` (m/s) from its steady state:
 /// the track's speed set (a speed profile dropped), the model parameter
 /// `v0` (the wheels' initial spin v0/r0 in the bundled vehicles: the guess

@@ -2,6 +2,7 @@
 //! errors, runs against independent single runs, failures, resume, and one
 //! plugin build per study.
 
+mod analyses;
 mod cases;
 mod critical_speed;
 mod errors;
