@@ -54,10 +54,10 @@ fn numeric(model: &Model) -> impl FnMut() -> Result<Box<dyn Equations>, RunError
     || Ok(Box::new(NumericEquations::new(model)))
 }
 
-fn settings(
-    c: &mut Criterion,
+fn settings<'a>(
+    c: &'a mut Criterion,
     name: &str,
-) -> criterion::BenchmarkGroup<'_, criterion::measurement::WallTime> {
+) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
     let mut g = c.benchmark_group(name);
     g.sample_size(10)
         .warm_up_time(Duration::from_millis(200))
