@@ -885,6 +885,11 @@ pub struct TrainScenario {
     /// Train-wide parameter overrides (applied to every vehicle whose model
     /// has the parameter; each must be known to at least one model).
     pub parameters: Vec<(String, String)>,
+    /// Where the run starts: as given (each vehicle's `init`, `vel` and
+    /// `initial` overrides), or at the train's static (steady)
+    /// equilibrium found from there, all vehicles and couplers solved
+    /// together (`initial_state: Equilibrium`, as for one vehicle).
+    pub initial_kind: InitialStateKind,
     /// Simulated time from t = 0, s.
     pub end_time: f64,
     /// The integrator and its settings, for the whole train.
@@ -920,6 +925,8 @@ struct RawTrain {
     threads: Option<usize>,
     #[serde(default)]
     parameters: OrderedMap<Value>,
+    #[serde(default)]
+    initial_state: InitialStateKind,
     end_time: f64,
     integrator: RawIntegrator,
     output: RawOutput,
@@ -1372,6 +1379,7 @@ pub fn parse_train(text: &str, path: &Path) -> Result<TrainScenario, ModelErrors
         elements,
         threads: raw.threads.unwrap_or(1),
         parameters,
+        initial_kind: raw.initial_state,
         end_time: raw.end_time,
         integrator,
         output,

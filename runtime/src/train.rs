@@ -19,6 +19,8 @@
 //! `start + offset` would, and a train of one vehicle without couplers runs
 //! the same trajectory as the plain scenario.
 
+use crate::analysis::CoordinateInfo;
+use crate::analysis::equilibrium::{Equilibrium, EquilibriumSettings};
 use crate::equations::{BodyKinematics, Equations, Parts};
 use crate::forces::{
     Characteristic, ForceContext, ForceElement, ForceJacobian, JacobianScratch, Linear6, Wrench,
@@ -36,7 +38,9 @@ use crate::run::{OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
-use railmbs_models::{BodyRef, Expr, Frame, Model, TrainCoupler, TrainForce, TrainScenario};
+use railmbs_models::{
+    BodyRef, Expr, Frame, InitialStateKind, Model, TrainCoupler, TrainForce, TrainScenario,
+};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::path::Path;
@@ -336,6 +340,43 @@ impl TrainSystem {
             }
             offset += s.forces().len();
         }
+    }
+
+    /// The wheel loads of every wheel–rail element of the train at the
+    /// state (t, q, q̇), named `<vehicle>.<element>`, as
+    /// [`crate::analysis::wheel_loads`] for one vehicle (the state is
+    /// accepted).
+    pub fn wheel_loads(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<(String, crate::forces::WheelLoads)>, SimError> {
+        self.accept_step(t, q, v)?;
+        let mut samples = Vec::new();
+        self.take_assessment_loads(&mut samples);
+        Ok(samples
+            .into_iter()
+            .map(|s| (self.assessment_name(s.key), s.loads))
+            .collect())
+    }
+
+    /// Every coupler's outputs at the state (t, q, q̇), named
+    /// `<coupler>.<output>` (`C12.Fx[N]`).
+    pub fn named_coupler_outputs(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<(String, f64)>, SimError> {
+        let mut values = Vec::new();
+        self.coupler_outputs(t, q, v, &mut values)?;
+        let names = self.couplers.iter().flat_map(|c| {
+            c.output_names()
+                .into_iter()
+                .map(|o| format!("{}.{o}", c.name))
+        });
+        Ok(names.zip(values).collect())
     }
 
     /// Long name of the element with assessment key `key`, prefixed by its
@@ -700,6 +741,12 @@ pub struct TrainSetup {
     pub breakpoints: Vec<f64>,
     /// The output header.
     pub header: Vec<String>,
+    /// The train's coordinates in system order, each named
+    /// `<vehicle>.<coordinate>` (`Coach2.Bogie1.WS1.ws.y`).
+    pub coordinates: Vec<CoordinateInfo>,
+    /// The equilibrium the run starts from (`initial_state: Equilibrium`):
+    /// all vehicles and couplers solved together.
+    pub equilibrium: Option<Equilibrium>,
     columns: TrainColumns,
 }
 
@@ -746,6 +793,7 @@ pub fn build_train_with(
     let mut header = vec!["time".to_string()];
     header.extend(ARC_COLUMNS.map(String::from));
     let (mut q0, mut v0, mut breakpoints) = (Vec::new(), Vec::new(), Vec::new());
+    let mut coordinates = Vec::new();
     let mut arc = None;
     // Contact tables built for one vehicle serve the others.
     for (k, (model, engine)) in models.iter().zip(engines).enumerate() {
@@ -780,6 +828,15 @@ pub fn build_train_with(
         let (q, v) = system.initial_state(0.0, &state.q, &state.v)?;
         q0.extend(q);
         v0.extend(v);
+        coordinates.extend(
+            crate::analysis::coordinates(model, &system)
+                .into_iter()
+                .map(|c| CoordinateInfo {
+                    name: format!("{name}.{}", c.name),
+                    owner: format!("{name}.{}", c.owner),
+                    kind: c.kind,
+                }),
+        );
         breakpoints.extend(times);
         vehicles.push((name.clone(), system));
     }
@@ -814,11 +871,32 @@ pub fn build_train_with(
     if arc.is_none() {
         header.remove(1);
     }
+    let equilibrium = match train.initial_kind {
+        InitialStateKind::Given => None,
+        InitialStateKind::Equilibrium => {
+            let eq = crate::analysis::equilibrium::solve(
+                &mut system,
+                &coordinates,
+                0.0,
+                &q0,
+                &v0,
+                &EquilibriumSettings::default(),
+            )
+            .map_err(|e| setup(format!("initial_state: Equilibrium: {e}")))?;
+            // The force elements' states (anchors, modes) start there.
+            system.accept_step(eq.t, &eq.q, &eq.v)?;
+            q0.clone_from(&eq.q);
+            v0.clone_from(&eq.v);
+            Some(eq)
+        }
+    };
     Ok(TrainSetup {
         system,
         q0,
         v0,
         breakpoints,
+        coordinates,
+        equilibrium,
         header: header.clone(),
         columns: TrainColumns {
             header,

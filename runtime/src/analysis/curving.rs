@@ -14,14 +14,14 @@
 //! of its model, exactly as a run would see them.
 
 use super::CoordinateInfo;
-use super::equilibrium::Equilibrium;
+use super::equilibrium::{Equilibrium, EquilibriumSettings};
 use super::speed::at_speed;
 use super::{CoordinateKind, wheel_loads};
 use crate::Equations;
 use crate::equations::Parts;
 use crate::forces::ContactTableCache;
 use crate::run::RunError;
-use crate::run::scenario::{ScenarioSystem, scenario_system_sharing};
+use crate::run::scenario::{ScenarioSystem, scenario_system_with};
 use railmbs_models::{Axis, ForceKind, InitialOverride, Model, Scenario};
 use railmbs_track::{Alignment, Direction, Section, Track};
 use std::sync::Arc;
@@ -158,16 +158,47 @@ pub const CONTINUATION_FACTOR: f64 = 1.5;
 /// straight track's state, which the model's initial state approximates).
 pub const CONTINUATION_START: f64 = 2e-4;
 
+/// Newton iterations of the direct solve before it gives up for the
+/// continuation in curvature: Vehicle 1 converges in 3–7 iterations from a
+/// nearby curve or speed and in 6–21 from its initial state where it
+/// converges at all (21: the 600 m curve with 100 mm cant at 40 m/s); a
+/// failing attempt costs no more than about twice a converging one.
+pub const DIRECT_ITERATIONS: usize = 30;
+
+/// Largest change of a position in one Newton step of the direct solve, m
+/// or rad ([`EquilibriumSettings::max_step`]): a third of the flangeway
+/// clearance of a standard wheelset (about 6–7 mm each side for S1002 or
+/// P8 on 1435 mm), so that no step carries a wheelset from one flange
+/// across to the other. With the default 0.1 m, Newton's method from the
+/// centred guess sent Vehicle 1's rear wheelset to the inner flange in the
+/// 600 m curve at 40 m/s and stalled there (≈ 400 N left), while the run in
+/// time settles with every wheelset towards the outer rail (the steady
+/// state this step finds).
+pub const DIRECT_MAX_STEP: f64 = 2e-3;
+
+/// Settings of the direct solve (from the model's initial state or from a
+/// guess): [`DIRECT_ITERATIONS`], [`DIRECT_MAX_STEP`].
+pub fn direct_settings() -> EquilibriumSettings {
+    EquilibriumSettings {
+        max_iterations: DIRECT_ITERATIONS,
+        max_step: DIRECT_MAX_STEP,
+        ..EquilibriumSettings::default()
+    }
+}
+
 /// The quasi-static curving solution of `scenario`'s vehicle in `curve`
 /// with engines from `engine` (one per solve), sharing the contact tables
 /// `tables`.
 ///
-/// Newton's method from the model's initial state (wheelsets centred)
-/// converges in wide curves; in a tight one (Vehicle 1 below about 400 m,
-/// where the leading wheelsets run on their flanges) the solve follows the
-/// curvature from [`CONTINUATION_START`] up in steps of
-/// [`CONTINUATION_FACTOR`], each from the state before (coordinates and
-/// rates), at the same cant and speed.
+/// Newton's method from the model's initial state (wheelsets centred),
+/// with steps of at most [`DIRECT_MAX_STEP`] and giving up after
+/// [`DIRECT_ITERATIONS`] ([`direct_settings`]), converges in wide curves
+/// and in moderate ones at high cant deficiency; in a tight one (Vehicle 1
+/// in the 150 m curve, where the leading wheelsets run on their flanges)
+/// the solve then follows the curvature from [`CONTINUATION_START`] up in
+/// steps of [`CONTINUATION_FACTOR`], each from the state before
+/// (coordinates and rates), at the same cant and speed, with the default
+/// [`EquilibriumSettings`].
 ///
 /// # Errors
 /// As [`curve_scenario`], a bad scenario, or no steady state (the
@@ -200,7 +231,8 @@ pub fn curving_from(
     let start = Instant::now();
     let solve = |engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
                  c: &Curve,
-                 guess: Option<(&[CoordinateInfo], &Equilibrium, f64)>| {
+                 guess: Option<(&[CoordinateInfo], &Equilibrium, f64)>,
+                 settings: &EquilibriumSettings| {
         let mut s = curve_scenario(scenario, model, c)?;
         if let Some((coordinates, eq, speed)) = guess {
             // The rolling rates scale with the speed.
@@ -216,10 +248,10 @@ pub fn curving_from(
                 })
                 .collect();
         }
-        scenario_system_sharing(&s, model, engine()?, tables)
+        scenario_system_with(&s, model, engine()?, tables, settings)
     };
     let first = guess.map(|g| (g.coordinates.as_slice(), &g.equilibrium, g.curve.speed));
-    let solved = match solve(engine, curve, first) {
+    let solved = match solve(engine, curve, first, &direct_settings()) {
         Ok(s) => s,
         Err(direct) => {
             let target = 1.0 / curve.radius.abs();
@@ -242,13 +274,15 @@ pub fn curving_from(
                         curve.speed,
                     )
                 });
-                let s = solve(engine, &c, from).map_err(|e| RunError::Setup {
-                    file: scenario.source.clone(),
-                    message: format!(
-                        "curving: no steady state directly ({direct}), nor by continuation in \
+                let s = solve(engine, &c, from, &EquilibriumSettings::default()).map_err(|e| {
+                    RunError::Setup {
+                        file: scenario.source.clone(),
+                        message: format!(
+                            "curving: no steady state directly ({direct}), nor by continuation in \
                          curvature, which stopped at R = {:.1} m: {e}",
-                        1.0 / kappa
-                    ),
+                            1.0 / kappa
+                        ),
+                    }
                 })?;
                 if kappa == target {
                     break s;

@@ -158,6 +158,26 @@ pub fn scenario_system_sharing(
     equations: Box<dyn Equations>,
     tables: &ContactTableCache,
 ) -> Result<ScenarioSystem, RunError> {
+    scenario_system_with(
+        scenario,
+        model,
+        equations,
+        tables,
+        &EquilibriumSettings::default(),
+    )
+}
+
+/// [`scenario_system_sharing`] solving the equilibrium (when the scenario
+/// asks for one) with `settings` instead of the defaults: an analysis that
+/// has a second way to the solution (quasi-static curving's continuation)
+/// lets a direct attempt give up early.
+pub fn scenario_system_with(
+    scenario: &Scenario,
+    model: &Model,
+    equations: Box<dyn Equations>,
+    tables: &ContactTableCache,
+    settings: &EquilibriumSettings,
+) -> Result<ScenarioSystem, RunError> {
     let setup = |message: String| RunError::Setup {
         file: scenario.source.clone(),
         message,
@@ -188,15 +208,9 @@ pub fn scenario_system_sharing(
     let equilibrium = match scenario.initial_kind {
         InitialStateKind::Given => None,
         InitialStateKind::Equilibrium => {
-            let eq = analysis::equilibrium::solve(
-                &mut system,
-                &coordinates,
-                0.0,
-                &q0,
-                &v0,
-                &EquilibriumSettings::default(),
-            )
-            .map_err(|e| setup(format!("initial_state: Equilibrium: {e}")))?;
+            let eq =
+                analysis::equilibrium::solve(&mut system, &coordinates, 0.0, &q0, &v0, settings)
+                    .map_err(|e| setup(format!("initial_state: Equilibrium: {e}")))?;
             // The force elements' states (anchors, modes) start there.
             system.accept_step(eq.t, &eq.q, &eq.v)?;
             q0.clone_from(&eq.q);

@@ -80,6 +80,76 @@ fn vehicle1_curves_quasi_statically_as_it_runs_through_track_case_1() {
     assert!(leading.lateral.unwrap() > 5e-3, "{leading:?}");
 }
 
+/// At high cant deficiency (the 600 m left curve with 100 mm cant at
+/// 40 m/s: 2.0 m/s² uncompensated) the steady state has every wheelset
+/// towards the outer (right) rail, the leading ones on the flange; Newton's
+/// method with the default 0.1 m steps went from the centred guess to a
+/// state with the rear wheelset at the inner flange and stalled (no steady
+/// state found). The run in time through a 100 m transition into the same
+/// curve (from its equilibrium on the straight lead-in) settles to it:
+/// its means over t = 6–14 s (arc 260–580 m, the whole vehicle in the
+/// circular curve from t ≈ 3 s) equal the quasi-static solution — every
+/// wheelset's lateral position and angle of attack, every wheel's Q and
+/// Y — within 1 %, as in track case 1.
+#[test]
+fn vehicle1_at_high_cant_deficiency_curves_quasi_statically_as_it_runs() {
+    let (mut s, model) = vehicle1_tc1();
+    let curve = Curve {
+        radius: 600.0,
+        cant: 0.1,
+        speed: 40.0,
+    };
+    let solved = solve(&s, &model, &curve);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("curve600.ron");
+    std::fs::write(
+        &file,
+        "Custom((sections: [
+            Straight(length: 30.0),
+            Transition(length: 100.0, direction: Left, radius_end: Some(600.0), cant_end: 0.1),
+            Curve(length: 1500.0, radius: 600.0, direction: Left, cant: 0.1),
+        ]))",
+    )
+    .unwrap();
+    let spec = s.track.as_mut().unwrap();
+    spec.load_file(&file).unwrap_or_else(|e| panic!("{e}"));
+    spec.start = 20.0;
+    spec.speed = 40.0;
+    s.set_parameter("v0", "40.0");
+    s.end_time = 14.0;
+    s.output.interval = 0.05;
+    let run = run_to_table(&s, &model, Box::new(NumericEquations::new(&model)));
+    let time = run.col("time");
+    let window: Vec<usize> = (0..time.len())
+        .filter(|&i| (6.0..=14.0).contains(&time[i]))
+        .collect();
+    assert!(window.len() > 100, "{} samples", window.len());
+    let mean = |col: &str| {
+        let c = run.col(col);
+        window.iter().map(|&i| c[i]).sum::<f64>() / window.len() as f64
+    };
+    for w in &solved.wheelsets {
+        let ws = w.wheelset.as_str();
+        // Towards the outer (right) rail, all four.
+        assert!(w.lateral.unwrap() < -4e-3, "{w:?}");
+        let mut checks = vec![
+            (format!("{ws}.y"), w.lateral.unwrap()),
+            (format!("{ws}.rz"), w.yaw.unwrap()),
+        ];
+        for name in ["L.Q [N]", "R.Q [N]", "L.Y [N]", "R.Y [N]"] {
+            checks.push((format!("{}.{name}", w.element), w.output(name).unwrap()));
+        }
+        for (col, quasi_static) in checks {
+            let run = mean(&col);
+            println!("{col}: run {run:.6e}, quasi-static {quasi_static:.6e}");
+            assert!(
+                (run - quasi_static).abs() < 0.01 * quasi_static.abs(),
+                "{col}: run {run}, quasi-static {quasi_static}"
+            );
+        }
+    }
+}
+
 /// In a wide curve (3000 m, no cant, 30 m/s) the solve converges from the
 /// centred guess directly and its wheel loads carry the vehicle's weight:
 /// ΣQ = M g (Vehicle 1's 32 000 + 2 × 2615 + 4 × 1813 kg, g = 9.81 m/s²)

@@ -297,3 +297,61 @@ fn a_coasting_vehicle_is_told_it_has_no_steady_state() {
     );
     assert!(!err.contains("iterations"), "{err}");
 }
+
+/// Three Vehicle 1 coaches coupled (`train3_straight.ron`: couplers of
+/// 2 MN/m longitudinally between the car bodies' ends, each coach with its
+/// own speed hold) on level straight track, solved as one system of 126
+/// coordinates: every wheel carries the single vehicle's hand statics
+/// (`vehicle1_hand_wheel_load`, 54 546 N), as each coach's own equilibrium
+/// repeated is a solution at which the couplers are at their free length
+/// (the attachment points 13 m ahead and behind coincide for coaches 26 m
+/// apart) and the solution is unique. The coupler forces are zero up to
+/// what the force tolerance allows: a residual of 0.019 N on a car body's
+/// x against its 1 MN/m speed hold moves two bodies apart by at most
+/// 4e-8 m, 0.08 N in a 2 MN/m coupler; 0.1 N is asserted.
+#[test]
+fn a_train_of_three_vehicle1_coaches_settles_to_the_hand_statics_with_free_couplers() {
+    let mut train =
+        railmbs_models::load_train(&model_path("scenarios/train3_straight.ron")).unwrap();
+    train.initial_kind = InitialStateKind::Equilibrium;
+    let models: Vec<Model> = train
+        .vehicles
+        .iter()
+        .map(|v| load_model(&v.model).unwrap())
+        .collect();
+    let refs: Vec<&Model> = models.iter().collect();
+    let engines: Vec<Box<dyn Equations>> = models
+        .iter()
+        .map(|m| Box::new(NumericEquations::new(m)) as Box<dyn Equations>)
+        .collect();
+    let mut setup = railmbs_runtime::train::build_train(&train, &refs, engines)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let eq = setup.equilibrium.clone().unwrap();
+    assert_eq!(eq.q.len(), 126);
+    assert_eq!(setup.coordinates[42].name, "Coach2.body.x");
+    for (i, c) in setup.coordinates.iter().enumerate() {
+        assert!(eq.roles[i] != Role::Held, "{} held", c.name);
+    }
+    let q_hand = vehicle1_hand_wheel_load(&models[0]);
+    let loads = setup.system.wheel_loads(eq.t, &eq.q, &eq.v).unwrap();
+    assert_eq!(loads.len(), 12);
+    for (name, w) in &loads {
+        for (side, (q, _y)) in ["left", "right"].iter().zip(w.loads) {
+            // As for one vehicle (assert_vehicle1_statics): 1e-5.
+            assert!(
+                (q - q_hand).abs() < 1e-5 * q_hand,
+                "{name} {side}: Q = {q} N, by hand {q_hand} N"
+            );
+        }
+    }
+    assert!(loads[4].0.starts_with("Coach2."), "{}", loads[4].0);
+    let couplers = setup
+        .system
+        .named_coupler_outputs(eq.t, &eq.q, &eq.v)
+        .unwrap();
+    let forces: Vec<&(String, f64)> = couplers.iter().filter(|(n, _)| n.contains(".F")).collect();
+    assert_eq!(forces.len(), 6, "{couplers:?}");
+    for (name, f) in forces {
+        assert!(f.abs() < 0.1, "{name} = {f} N");
+    }
+}
