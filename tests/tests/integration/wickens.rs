@@ -35,18 +35,20 @@ const GRAVITY: f64 = 9.81;
 /// (y = 0), per wheel, from the profiles (S1002 on UIC60 1:40, Vehicle 1's
 /// wheelset: r0 = 0.46 m, back to back 1.360 m, gauge 1.435 m).
 #[derive(Debug)]
-struct WheelsetContact {
+pub(super) struct WheelsetContact {
     /// Rolling radius at the contact, m.
-    r0: f64,
+    pub(super) r0: f64,
     /// Half the lateral distance of the contact points on the wheels, m.
-    e: f64,
+    pub(super) e: f64,
     /// Equivalent conicity of the linearization, ½ dΔr/dy (–).
-    conicity: f64,
+    pub(super) conicity: f64,
     /// Contact angle δ0 (rad) and d(δ_L − δ_R)/dy (1/m).
-    delta0: f64,
-    d_delta: f64,
+    pub(super) delta0: f64,
+    pub(super) d_delta: f64,
     /// d(tan δ_L − tan δ_R)/dy, 1/m.
-    d_tan_delta: f64,
+    pub(super) d_tan_delta: f64,
+    /// The rigid wheelset's roll per lateral shift, dθ/dy (rad/m).
+    pub(super) d_roll: f64,
     /// Kalker's coefficients and the ellipse's semi-axes at the static load.
     kalker: KalkerCoefficients,
     a: f64,
@@ -58,7 +60,7 @@ struct WheelsetContact {
 impl WheelsetContact {
     /// f11 = G a b C11, f22 = G a b C22 (N), f23 = G (ab)^{3/2} C23 (N m),
     /// f33 = G (ab)² C33 (N m²): Kalker's linear theory (Kalker 1967).
-    fn coefficients(&self) -> (f64, f64, f64, f64) {
+    pub(super) fn coefficients(&self) -> (f64, f64, f64, f64) {
         let c2 = self.a * self.b;
         let gc2 = self.g * c2;
         (
@@ -70,22 +72,25 @@ impl WheelsetContact {
     }
 }
 
-fn contact_geometry() -> ContactGeometry {
+/// The rigid contact geometry of a wheelset with the bundled wheel profile
+/// `wheel` (a file in `models/profiles`) and nominal rolling radius `r0`
+/// (m), back to back 1.360 m, on UIC60 1:40 rails at gauge 1.435 m (the
+/// WheelRail element's and the straight track's defaults).
+pub(super) fn contact_geometry_of(wheel: &str, r0: f64) -> ContactGeometry {
     let profiles = model_path("profiles");
     let s = ProfileSettings::default();
-    let wheel = Profile::read(
-        &profiles.join("MBench_S1002_v3.prw"),
-        ProfileKind::Wheel,
-        &s,
-    )
-    .unwrap();
+    let wheel = Profile::read(&profiles.join(wheel), ProfileKind::Wheel, &s).unwrap();
     let rail = Profile::read(&profiles.join("MBench_UIC60_v3.ban"), ProfileKind::Rail, &s).unwrap();
     ContactGeometry::new(
-        &Wheelset::new(wheel.clone(), wheel, 0.46, 1.360),
+        &Wheelset::new(wheel.clone(), wheel, r0, 1.360),
         &Track::new(rail.clone(), rail, 1.435),
         SearchSettings::default(),
     )
     .unwrap()
+}
+
+fn contact_geometry() -> ContactGeometry {
+    contact_geometry_of("MBench_S1002_v3.prw", 0.46)
 }
 
 /// The parameters at y = 0 under the vertical wheel load `q` (N): slopes by
@@ -93,7 +98,11 @@ fn contact_geometry() -> ContactGeometry {
 /// for the profile pair's linear range around the centre, large enough to
 /// span several grid points of the profiles' splines.
 fn wheelset_contact(q: f64, h: f64) -> WheelsetContact {
-    let geo = contact_geometry();
+    wheelset_contact_on(&contact_geometry(), q, h)
+}
+
+/// As [`wheelset_contact`] on the contact geometry `geo`.
+pub(super) fn wheelset_contact_on(geo: &ContactGeometry, q: f64, h: f64) -> WheelsetContact {
     let at = |y: f64| -> RigidContact { geo.rigid(y).unwrap() };
     let (c, plus, minus) = (at(0.0), at(h), at(-h));
     let left = |r: &RigidContact| *r.sides[0].deepest();
@@ -119,6 +128,7 @@ fn wheelset_contact(q: f64, h: f64) -> WheelsetContact {
         delta0,
         d_delta: slope(&|r| left(r).contact_angle - right(r).contact_angle),
         d_tan_delta: slope(&|r| left(r).contact_angle.tan() - right(r).contact_angle.tan()),
+        d_roll: slope(&|r| r.roll),
         kalker: KalkerCoefficients::interpolate_ab(hertz.a, hertz.b, POISSON).unwrap(),
         a: hertz.a,
         b: hertz.b,
@@ -228,7 +238,7 @@ fn soft_wheelset(law: Option<CreepLawSpec<railmbs_models::Expr>>) -> (Scenario, 
     (s, model)
 }
 
-fn param(model: &Model, s: &Scenario, name: &str) -> f64 {
+pub(super) fn param(model: &Model, s: &Scenario, name: &str) -> f64 {
     s.parameter_values(model).unwrap()[model.parameter_index(name).unwrap()]
 }
 
@@ -263,7 +273,7 @@ fn suspension(model: &Model, s: &Scenario) -> Suspension {
 }
 
 /// Frequency (Hz) and damping ratio of an eigenvalue (σ, ω).
-fn frequency_and_damping((re, im): (f64, f64)) -> (f64, f64) {
+pub(super) fn frequency_and_damping((re, im): (f64, f64)) -> (f64, f64) {
     (im / (2.0 * std::f64::consts::PI), -re / re.hypot(im))
 }
 
