@@ -346,8 +346,9 @@ impl LoadFriction {
             mu: 0.0,
             free_length: 0.0,
             x2: 0.0,
-            // Unloaded block: no friction capacity, so the first motion slides.
-            mode: FrictionMode::Stick { f0: 0.0, x0: 0.0 },
+            // Unloaded block: no friction capacity, so the first motion
+            // slides (see `law` and `accept_step`).
+            mode: FrictionMode::Initial,
         }
     }
 
@@ -373,7 +374,15 @@ impl LoadFriction {
                 let (f, k, x2) = self.sliding(x, dir, self.mu);
                 (f, k, x2, Branch::Slide)
             }
-            FrictionMode::Stick { .. } | FrictionMode::Initial => {
+            FrictionMode::Initial => {
+                // Never accepted (a static equilibrium): the virgin loading
+                // branch, as the first accepted step makes it (unloaded, the
+                // block has no friction capacity and slides away from x = 0).
+                let sx = if x >= 0.0 { 1.0 } else { -1.0 };
+                let (f, k, x2) = self.sliding(x, sx, self.mu);
+                (f, k, x2, Branch::Slide)
+            }
+            FrictionMode::Stick { .. } => {
                 let f = self.c1 * (x - self.x2);
                 let excess = f - self.c2 * self.x2;
                 if excess.abs() <= self.mu_static * self.c2 * self.x2.abs() {
@@ -466,6 +475,10 @@ impl ForceElement for LoadFriction {
     }
 
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
+        if self.mode == FrictionMode::Initial {
+            // The unloaded block (x2 = 0), sticking with no capacity.
+            self.mode = FrictionMode::Stick { f0: 0.0, x0: 0.0 };
+        }
         let s = self.pair.state(ctx);
         let (_, _, x2, branch) = self.law(s.length - self.free_length, s.rate);
         self.mode = match (self.mode, branch) {
