@@ -185,6 +185,23 @@ impl ModelSystem {
             .collect()
     }
 
+    /// Lets the force elements keep the states they were built with (no
+    /// stick anchor, no friction mode, no accepted rail state) until the
+    /// next accepted step, instead of accepting the state of the first
+    /// evaluation. The static equilibrium is solved so
+    /// ([`crate::run::scenario_system`]): accepted at the initial guess, a
+    /// contact or friction element would stick there, and its anchor would
+    /// hold whatever force the settling to the equilibrium puts on it (up to
+    /// the static limit), an equilibrium the element forgets at the next
+    /// accepted step. Never accepted, such an element at rest carries no
+    /// friction force: the equilibrium found is the frictionless one (a valid
+    /// static state with friction too, zero being inside every friction
+    /// cone), and accepting it afterwards sticks every element there with
+    /// its force unchanged.
+    pub fn keep_initial_force_states(&mut self) {
+        self.forces_initialized = true;
+    }
+
     /// The system's initial q and q̇ from the coordinates' (`q`, `v`, n
     /// entries each): appends the element states and rates consistent with
     /// their equations at (t, q, v).

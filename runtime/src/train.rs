@@ -279,6 +279,15 @@ impl TrainSystem {
         })
     }
 
+    /// Every vehicle keeps its force elements' states as built until the
+    /// next accepted step ([`ModelSystem::keep_initial_force_states`]): the
+    /// train's static equilibrium is the frictionless one, as a vehicle's.
+    pub fn keep_initial_force_states(&mut self) {
+        for vehicle in &mut self.vehicles {
+            vehicle.keep_initial_force_states();
+        }
+    }
+
     /// Evaluates the vehicles in `threads` threads (1: sequentially in the
     /// calling thread, the default); results are identical either way (the
     /// vehicles are independent between coupler evaluations: Pogorelov
@@ -874,6 +883,8 @@ pub fn build_train_with(
     let equilibrium = match train.initial_kind {
         InitialStateKind::Given => None,
         InitialStateKind::Equilibrium => {
+            // Frictionless, as a vehicle's (run::scenario_system_with).
+            system.keep_initial_force_states();
             let eq = crate::analysis::equilibrium::solve(
                 &mut system,
                 &coordinates,

@@ -132,6 +132,8 @@ struct PointEval {
     n: Vector3<f64>,
     /// Penetration, m.
     delta: f64,
+    /// Its rate δ̇ = −n·v_r, m/s.
+    delta_rate: f64,
     /// N.
     normal_force: f64,
     /// Tangential force on the point's body, N (SC0).
@@ -309,6 +311,7 @@ impl PointPlane {
             p,
             n,
             delta,
+            delta_rate,
             normal_force,
             ft,
             trial,
@@ -355,6 +358,39 @@ impl PointPlane {
 
     fn body(&self) -> Option<usize> {
         self.points.first().and_then(|a| a.body)
+    }
+
+    /// Elastic energy (J) and dissipated power (W) of one point in contact.
+    ///
+    /// The energy is ½ c δ² of the normal spring and, while the point sticks
+    /// (also beyond the limit, until the breakaway is accepted), ½ c_t |s_t|²
+    /// of its anchor spring (c_t s_t = −trial − d_t v_t). The power is what
+    /// the balance leaves: the contact's forces do the work F·v_r on the two
+    /// bodies (F = N n + F_t on the point's body, −F on the plane's at the
+    /// same place), and d/dt ½ c δ² = c δ δ̇, d/dt ½ c_t |s_t|² = c_t s_t·v_t
+    /// exactly (the anchor and the normal turn with the plane body), so
+    /// P = (N − c δ) δ̇ − F_t·v_t − c_t s_t·v_t: d δ̇² (or −c δ δ̇ > 0 where
+    /// the damper would pull and N is held at 0), plus d_t |v_t|² sticking,
+    /// μ N |v_t| sliding. Held at the static limit within a step, the anchor
+    /// spring may be stretched faster than the limit force works, and P is
+    /// then negative until the breakaway. At a mode change (an accepted
+    /// step) the anchor's energy is released (breakaway: ½ c_t |s_t|², about
+    /// ½ (μ0 N)²/c_t) or stored (a new anchor carrying the sliding force:
+    /// ½ (μ N)²/c_t); P does not hold these jumps.
+    fn energy_and_dissipation(&self, e: &PointEval) -> (f64, f64) {
+        let normal = (
+            0.5 * self.c * e.delta * e.delta,
+            (e.normal_force - self.c * e.delta) * e.delta_rate,
+        );
+        let slip = -e.ft.dot(&e.vt);
+        let (energy, power) = match e.branch {
+            Tangential::Stick | Tangential::Saturated(_) => {
+                let cs = -e.trial - self.dt * e.vt;
+                (0.5 * cs.norm_squared() / self.ct, slip - cs.dot(&e.vt))
+            }
+            Tangential::Slide(..) => (0.0, slip),
+        };
+        (normal.0 + energy, normal.1 + power)
     }
 }
 
@@ -439,12 +475,15 @@ impl ForceElement for PointPlane {
                 v.push(format!("{k}.{q}"));
             }
         }
+        v.extend(["E[J]".to_string(), "P[W]".to_string()]);
         v
     }
 
     /// Per point: N, the tangential force (SC0), the penetration and the mode
-    /// (0 free, 1 sticking, 2 sliding).
+    /// (0 free, 1 sticking, 2 sliding); then the elastic energy and the
+    /// dissipated power of all points (`energy_and_dissipation`).
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
+        let (mut energy, mut power) = (0.0, 0.0);
         for k in 0..self.points.len() {
             let mode = match self.modes[k] {
                 ContactMode::Free => 0.0,
@@ -452,10 +491,16 @@ impl ForceElement for PointPlane {
                 ContactMode::Slide { .. } => 2.0,
             };
             match self.evaluate(ctx, k) {
-                Some(e) => out.extend([e.normal_force, e.ft.x, e.ft.y, e.ft.z, e.delta, mode]),
+                Some(e) => {
+                    let (ek, pk) = self.energy_and_dissipation(&e);
+                    energy += ek;
+                    power += pk;
+                    out.extend([e.normal_force, e.ft.x, e.ft.y, e.ft.z, e.delta, mode]);
+                }
                 None => out.extend([0.0, 0.0, 0.0, 0.0, 0.0, mode]),
             }
         }
+        out.extend([energy, power]);
     }
 
     fn remembers_accepted_steps(&self) -> bool {

@@ -186,18 +186,39 @@ impl ForceElement for CoulombFriction {
     }
 
     fn output_names(&self) -> Vec<String> {
-        ["F[N]", "x[m]", "v[m/s]", "sliding[-]"]
+        ["F[N]", "x[m]", "v[m/s]", "sliding[-]", "E[J]", "P[W]"]
             .iter()
             .map(|s| s.to_string())
             .collect()
     }
 
+    /// Force, length, rate, mode (1 sliding); the elastic energy f_e²/(2c)
+    /// of the sticking spring, f_e = f0 + c (x − x0) (J; also beyond the
+    /// limit until the breakaway is accepted, 0 sliding), and the dissipated
+    /// power F ẋ − f_e ẋ (W): d ẋ² sticking, F_s |ẋ| sliding (F resists
+    /// extension, so its power on the bodies is −F ẋ, and d/dt f_e²/(2c) =
+    /// f_e ẋ). Held at the static limit within a step, P = (F − f_e) ẋ may be
+    /// negative until the breakaway. At a mode change (an accepted step) the
+    /// spring's energy is released (breakaway, about F0²/(2c)) or stored (a
+    /// new stick carrying the sliding force, F_s²/(2c)); P does not hold
+    /// these jumps.
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let s = self.pair.state(ctx);
         let (f, ..) = self.law(s.length, s.rate);
         let f = if s.direction.is_some() { f } else { 0.0 };
         let sliding = matches!(self.mode, FrictionMode::Slide { .. }) as u8 as f64;
-        out.extend([f, s.length, s.rate, sliding]);
+        let spring = match self.mode {
+            FrictionMode::Stick { f0, x0 } => f0 + self.stiffness * (s.length - x0),
+            FrictionMode::Slide { .. } | FrictionMode::Initial => 0.0,
+        };
+        out.extend([
+            f,
+            s.length,
+            s.rate,
+            sliding,
+            0.5 * spring * spring / self.stiffness,
+            (f - spring) * s.rate,
+        ]);
     }
 
     fn remembers_accepted_steps(&self) -> bool {
@@ -325,9 +346,17 @@ impl LoadFriction {
             mu: 0.0,
             free_length: 0.0,
             x2: 0.0,
-            // Unloaded block: no friction capacity, so the first motion slides.
-            mode: FrictionMode::Stick { f0: 0.0, x0: 0.0 },
+            // Unloaded block: no friction capacity, so the first motion
+            // slides (see `law` and `accept_step`).
+            mode: FrictionMode::Initial,
         }
+    }
+
+    /// x2/x = c1/(c1 + a), a = c2 (1 + s μ sign x), on the sliding branch in
+    /// direction `s` with coefficient `mu` (`sx` the sign of x).
+    fn branch_ratio(&self, sx: f64, s: f64, mu: f64) -> f64 {
+        let a = self.c2 * (1.0 + s * sx * mu);
+        self.c1 / (self.c1 + a)
     }
 
     /// Sliding branch in direction `s` with coefficient `mu`: (F, ∂F/∂x, x2).
@@ -345,7 +374,15 @@ impl LoadFriction {
                 let (f, k, x2) = self.sliding(x, dir, self.mu);
                 (f, k, x2, Branch::Slide)
             }
-            FrictionMode::Stick { .. } | FrictionMode::Initial => {
+            FrictionMode::Initial => {
+                // Never accepted (a static equilibrium): the virgin loading
+                // branch, as the first accepted step makes it (unloaded, the
+                // block has no friction capacity and slides away from x = 0).
+                let sx = if x >= 0.0 { 1.0 } else { -1.0 };
+                let (f, k, x2) = self.sliding(x, sx, self.mu);
+                (f, k, x2, Branch::Slide)
+            }
+            FrictionMode::Stick { .. } => {
                 let f = self.c1 * (x - self.x2);
                 let excess = f - self.c2 * self.x2;
                 if excess.abs() <= self.mu_static * self.c2 * self.x2.abs() {
@@ -400,19 +437,37 @@ impl ForceElement for LoadFriction {
     }
 
     fn output_names(&self) -> Vec<String> {
-        ["F[N]", "x[m]", "x2[m]", "sliding[-]"]
+        ["F[N]", "x[m]", "x2[m]", "sliding[-]", "E[J]", "P[W]"]
             .iter()
             .map(|s| s.to_string())
             .collect()
     }
 
+    /// Force, deflection, the block's deformation x2, mode (1 sliding); the
+    /// elastic energy ½ c1 (x − x2)² + ½ c2 x2² of the two springs (J) and
+    /// the dissipated power F ẋ − dE/dt (W; F resists extension, so its power
+    /// on the bodies is −F ẋ): 0 sticking (x2 held), and on a sliding branch
+    /// (x2 = r x, r = c1/(c1 + a)) r ẋ (F − c2 x2) = r μ c2 |x2| |ẋ| while
+    /// the block slides the way ẋ goes.
     fn outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
         let s = self.pair.state(ctx);
         let x = s.length - self.free_length;
-        let (f, _, x2, _) = self.law(x, s.rate);
+        let (f, _, x2, branch) = self.law(x, s.rate);
         let f = if s.direction.is_some() { f } else { 0.0 };
         let sliding = matches!(self.mode, FrictionMode::Slide { .. }) as u8 as f64;
-        out.extend([f, x, x2, sliding]);
+        let energy = 0.5 * self.c1 * (x - x2).powi(2) + 0.5 * self.c2 * x2 * x2;
+        // ẋ2 on the branch the law took (its direction s and coefficient).
+        let sx = if x >= 0.0 { 1.0 } else { -1.0 };
+        let x2_rate = match (branch, self.mode) {
+            (Branch::Stick, _) => 0.0,
+            (Branch::Saturated(sign), _) => self.branch_ratio(sx, sign, self.mu_static) * s.rate,
+            (Branch::Slide, FrictionMode::Slide { dir, .. }) => {
+                self.branch_ratio(sx, dir, self.mu) * s.rate
+            }
+            (Branch::Slide, _) => self.branch_ratio(sx, sx, self.mu) * s.rate,
+        };
+        let power = f * s.rate - self.c1 * (x - x2) * (s.rate - x2_rate) - self.c2 * x2 * x2_rate;
+        out.extend([f, x, x2, sliding, energy, power]);
     }
 
     fn remembers_accepted_steps(&self) -> bool {
@@ -420,6 +475,10 @@ impl ForceElement for LoadFriction {
     }
 
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
+        if self.mode == FrictionMode::Initial {
+            // The unloaded block (x2 = 0), sticking with no capacity.
+            self.mode = FrictionMode::Stick { f0: 0.0, x0: 0.0 };
+        }
         let s = self.pair.state(ctx);
         let (_, _, x2, branch) = self.law(s.length - self.free_length, s.rate);
         self.mode = match (self.mode, branch) {

@@ -137,7 +137,8 @@ pub struct ScenarioSystem {
 /// Builds the system of `scenario` on `model` with the engine `equations`:
 /// parameters and initial state, the track, and, when the scenario asks for
 /// it (`initial_state: Equilibrium`), the equilibrium at t = 0 from that
-/// state (the force elements' states are then accepted there).
+/// state, solved with the force elements' states as built (frictionless:
+/// [`ModelSystem::keep_initial_force_states`]) and then accepted there.
 ///
 /// # Errors
 /// A bad scenario, or no equilibrium (the message names the scenario file).
@@ -208,6 +209,8 @@ pub fn scenario_system_with(
     let equilibrium = match scenario.initial_kind {
         InitialStateKind::Given => None,
         InitialStateKind::Equilibrium => {
+            // Frictionless: no element state is accepted at the guess.
+            system.keep_initial_force_states();
             let eq =
                 analysis::equilibrium::solve(&mut system, &coordinates, 0.0, &q0, &v0, settings)
                     .map_err(|e| setup(format!("initial_state: Equilibrium: {e}")))?;

@@ -295,7 +295,7 @@ fn short_runs_judge_the_peaks() {
 /// gravity and of constant applied forces, the elastic energies the force
 /// elements report: outputs `E[J]`, `Eel [J]`) and the dissipated power the
 /// elements report (`P[W]`, `P [W]`) at every output row of a run of `model`.
-fn energy_and_dissipation(
+pub(crate) fn energy_and_dissipation(
     model: &railmbs_models::Model,
     params: &[f64],
     out: &Table,
@@ -396,7 +396,7 @@ fn energy_and_dissipation(
 /// Checks an energy balance (lost, dissipated, largest gap, J): at least
 /// `min` J dissipated, the net gap below `net` and the largest below `worst`
 /// (fractions of the dissipated energy).
-fn assert_balance(
+pub(crate) fn assert_balance(
     name: &str,
     (lost, dissipated, gap): (f64, f64, f64),
     (min, net, worst): (f64, f64, f64),
@@ -418,7 +418,7 @@ fn assert_balance(
 /// Runs `scenario` with all bodies and elements written and returns (energy
 /// lost, energy dissipated, largest gap between them on the way) from `t0`
 /// to the end ([`energy_and_dissipation`]).
-fn energy_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64, f64) {
+pub(crate) fn energy_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f64, f64) {
     // From the given state: a coasting vehicle has no steady state.
     scenario.initial_kind = railmbs_models::InitialStateKind::Given;
     let model = railmbs_models::load_model(&scenario.model).unwrap();
