@@ -740,7 +740,7 @@ mod tests {
         let (dense, block) = train.factorization_work();
         assert!(train.pays() && block < 0.2 * dense, "{block} vs {dense}");
         // One block: nothing to gain.
-        let one = BlockPattern::new(vec![0..10], vec![]).unwrap();
+        let one = BlockPattern::new(Vec::from([0..10]), vec![]).unwrap();
         assert!(!one.pays());
     }
 }

@@ -130,13 +130,15 @@ pub enum JacobianKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LinearSolver {
     /// Dense LU with partial pivoting of the whole matrix.
-    #[default]
     Dense,
     /// The bordered block-diagonal LU of [`crate::block`] with M and the
     /// Jacobians assembled blockwise, when the system has a block pattern
     /// ([`MechanicalSystem::block_pattern`]: a train's vehicles coupled
     /// through their couplers' bodies) and no constraints; the dense LU
     /// otherwise. Same solutions to rounding (the summation order differs).
+    /// The default: systems without a pattern solve exactly as with
+    /// [`LinearSolver::Dense`].
+    #[default]
     Block,
 }
 

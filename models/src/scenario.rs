@@ -20,13 +20,13 @@ pub enum JacobianKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum LinearSolverKind {
     /// Dense LU of the whole matrix (every model; the reference).
-    #[default]
     Dense,
     /// Trains: the vehicles as diagonal blocks and the coordinates of the
     /// coupled bodies as the border, factorized by the bordered
     /// block-diagonal LU (work linear in the number of vehicles). Models
     /// without such structure (one vehicle) and constrained trains use the
-    /// dense LU.
+    /// dense LU. The default.
+    #[default]
     Block,
 }
 
@@ -45,8 +45,8 @@ pub enum IntegratorSpec {
         initial_step: Option<f64>,
         /// Jacobian of the Newton iteration (default `FiniteDifference`).
         jacobian: JacobianKind,
-        /// Linear solver of the Newton iteration (`solver: Dense` or
-        /// `solver: Block`; default `Dense`).
+        /// Linear solver of the Newton iteration (`solver: Block`, the
+        /// default, or `solver: Dense`).
         solver: LinearSolverKind,
     },
     /// Classical explicit fourth-order Runge–Kutta with fixed step (models
