@@ -38,6 +38,43 @@ pub struct Args {
     /// file's `threads`; 1: sequentially). The output does not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Linear solver of Park's method (overrides the integrator's `solver`):
+    /// `dense` LU of the whole iteration matrix, or `block`, the bordered
+    /// block-diagonal LU of a train (vehicles as blocks, the coupled bodies'
+    /// coordinates as the border; dense for models without that structure).
+    #[arg(long, value_enum)]
+    pub solver: Option<Solver>,
+}
+
+/// `--solver`: [`railmbs_models::LinearSolverKind`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Solver {
+    /// Dense LU of the whole matrix.
+    Dense,
+    /// Bordered block-diagonal LU where the system has a block pattern.
+    Block,
+}
+
+/// Sets Park's linear solver of `spec` to `solver` (`--solver`).
+fn set_solver(
+    spec: &mut railmbs_models::IntegratorSpec,
+    solver: Option<Solver>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let Some(solver) = solver else {
+        return Ok(());
+    };
+    match spec {
+        railmbs_models::IntegratorSpec::Park { solver: s, .. } => {
+            *s = match solver {
+                Solver::Dense => railmbs_models::LinearSolverKind::Dense,
+                Solver::Block => railmbs_models::LinearSolverKind::Block,
+            };
+            Ok(())
+        }
+        railmbs_models::IntegratorSpec::Rk4 { .. } => {
+            Err("--solver: the scenario's integrator is RK4, which has no Newton solve".into())
+        }
+    }
 }
 
 /// `NAME=VALUE` of `--set`.
@@ -68,12 +105,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 }
                 t.threads = n;
             }
+            set_solver(&mut t.integrator, args.solver)?;
             return run_train(args, &t);
         }
     };
     for (name, value) in &args.set {
         scenario.set_parameter(name, value);
     }
+    set_solver(&mut scenario.integrator, args.solver)?;
     if let Some(t) = args.end_time {
         scenario
             .set_end_time(t)

@@ -49,12 +49,16 @@
 
 use nalgebra::DVector;
 
+pub mod block;
 pub mod linalg;
 pub mod park;
 pub mod rk4;
 pub mod system;
 
-pub use park::{JacobianKind, Park, ParkSettings, integrate_park, integrate_park_steps};
+pub use block::{BlockMatrix, BlockPattern, BorderedLu};
+pub use park::{
+    JacobianKind, LinearSolver, Park, ParkSettings, integrate_park, integrate_park_steps,
+};
 pub use rk4::{Rk4, Rk4Settings, integrate_rk4};
 pub use system::{MechanicalSystem, SimError};
 

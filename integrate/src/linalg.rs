@@ -109,10 +109,14 @@ impl DenseLu {
 
     /// Solve `A x = b` in place (b becomes x) with the stored factorization.
     pub fn solve_in_place(&self, b: &mut DVector<f64>) {
+        self.solve_slice(b.as_mut_slice());
+    }
+
+    /// [`DenseLu::solve_in_place`] on a slice of length [`DenseLu::dim`].
+    pub fn solve_slice(&self, x: &mut [f64]) {
         debug_assert!(self.valid, "solve with an invalid LU factorization");
         let n = self.dim();
         let a = self.lu.as_slice();
-        let x = b.as_mut_slice();
         for k in 0..n {
             let p = self.piv[k];
             if p != k {

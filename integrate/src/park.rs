@@ -97,8 +97,11 @@
 
 use std::ops::ControlFlow;
 
+use std::sync::Arc;
+
 use nalgebra::{Cholesky, DMatrix, DVector};
 
+use super::block::{BlockMatrix, BlockPattern, BorderedLu};
 use super::linalg::DenseLu;
 use super::{
     BeforeAccept, IntegrationStats, StepView, Stepper, at_stop_time, check_end_time, check_finite,
@@ -119,6 +122,24 @@ pub enum JacobianKind {
     /// [`MechanicalSystem::force_jacobian`];
     /// falls back to forward differences when the system returns `false`.
     Analytic,
+}
+
+/// How Park's method solves its linear systems: the Newton iteration
+/// matrix `M − β ∂f/∂q̇ − β² ∂f/∂q` and, without constraints, the q̈ solve
+/// `M q̈ = f` of the initial state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearSolver {
+    /// Dense LU with partial pivoting of the whole matrix.
+    Dense,
+    /// The bordered block-diagonal LU of [`crate::block`] with M and the
+    /// Jacobians assembled blockwise, when the system has a block pattern
+    /// ([`MechanicalSystem::block_pattern`]: a train's vehicles coupled
+    /// through their couplers' bodies) and no constraints; the dense LU
+    /// otherwise. Same solutions to rounding (the summation order differs).
+    /// The default: systems without a pattern solve exactly as with
+    /// [`LinearSolver::Dense`].
+    #[default]
+    Block,
 }
 
 /// Settings of Park's method.
@@ -156,6 +177,8 @@ pub struct ParkSettings {
     /// constraint evaluations and one LU factorization of size n + nc per
     /// step. The integration itself is unchanged.
     pub consistent_multipliers: bool,
+    /// How the linear systems are solved.
+    pub solver: LinearSolver,
 }
 
 impl Default for ParkSettings {
@@ -171,6 +194,7 @@ impl Default for ParkSettings {
             max_newton_iterations: 8,
             newton_tol: None,
             consistent_multipliers: false,
+            solver: LinearSolver::default(),
         }
     }
 }
@@ -274,6 +298,68 @@ struct StepCoefficients {
     lte_ratio: f64,
 }
 
+/// The matrices of a system with a block pattern ([`LinearSolver::Block`]),
+/// in place of the dense ones of [`Work`].
+#[derive(Debug)]
+struct BlockWork {
+    /// M of the current evaluation.
+    mass: BlockMatrix,
+    /// M, ∂f/∂q, ∂f/∂q̇ of the Jacobian snapshot.
+    mass_j: BlockMatrix,
+    dfdq: BlockMatrix,
+    dfdv: BlockMatrix,
+    /// M of the finite-difference evaluations (unused).
+    mass_pert: BlockMatrix,
+    /// The matrix being factorized.
+    scratch: BlockMatrix,
+    /// Factorization of the iteration matrix.
+    lu: BorderedLu,
+    /// Factorization of M (the q̈ solve).
+    lu_mass: BorderedLu,
+    /// The pattern and its finite-difference column groups.
+    pattern: Arc<BlockPattern>,
+    groups: Vec<Vec<usize>>,
+}
+
+impl BlockWork {
+    fn new(pattern: &Arc<BlockPattern>) -> Self {
+        let z = || BlockMatrix::zeros(pattern);
+        Self {
+            mass: z(),
+            mass_j: z(),
+            dfdq: z(),
+            dfdv: z(),
+            mass_pert: z(),
+            scratch: z(),
+            lu: BorderedLu::new(pattern),
+            lu_mass: BorderedLu::new(pattern),
+            groups: pattern.difference_groups(),
+            pattern: pattern.clone(),
+        }
+    }
+}
+
+/// Fails with [`SimError::NonFinite`] naming the time, the quantity and the
+/// first offending entry (i, j) when `m` holds a NaN or an infinity.
+fn check_finite_blocks(t: f64, what: &str, m: &BlockMatrix) -> Result<(), SimError> {
+    if m.values().all(f64::is_finite) {
+        return Ok(());
+    }
+    let n = m.pattern().dim();
+    for j in 0..n {
+        for i in 0..n {
+            let x = m.get(i, j);
+            if !x.is_finite() {
+                return Err(SimError::NonFinite {
+                    t,
+                    what: format!("{what}[({i}, {j})] = {x}"),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Workspaces sized for one system (n coordinates, nc constraints).
 #[derive(Debug)]
 struct Work {
@@ -333,31 +419,38 @@ struct Work {
     wq: DVector<f64>,
     /// Derivative-formula weights c₀..c₃ and predictor weights.
     c: [f64; 4],
+    /// The block matrices and factorizations ([`LinearSolver::Block`]); the
+    /// dense matrices `mass` … `mass_pert`, `lu`, `lu_kkt` are then empty.
+    block: Option<BlockWork>,
 }
 
 impl Work {
-    fn new(n: usize, nc: usize) -> Self {
+    fn new(n: usize, nc: usize, pattern: Option<&Arc<BlockPattern>>) -> Self {
         let v = || DVector::zeros(n);
+        // Dense matrices only without a block pattern.
+        let nd = if pattern.is_some() { 0 } else { n };
+        let sq = || DMatrix::zeros(nd, nd);
         Self {
+            block: pattern.map(BlockWork::new),
             n,
             nc,
-            mass: DMatrix::zeros(n, n),
+            mass: sq(),
             force: v(),
             gval: DVector::zeros(nc),
             gjac: DMatrix::zeros(nc, n),
-            mass_j: DMatrix::zeros(n, n),
-            dfdq: DMatrix::zeros(n, n),
-            dfdv: DMatrix::zeros(n, n),
+            mass_j: sq(),
+            dfdq: sq(),
+            dfdv: sq(),
             gjac_j: DMatrix::zeros(nc, n),
             f0: v(),
             f_pert: v(),
             f_pert2: v(),
-            mass_pert: DMatrix::zeros(n, n),
+            mass_pert: sq(),
             x_pert: v(),
             analytic_ok: true,
             constrained: vec![false; n],
-            lu: DenseLu::new(n + nc),
-            lu_kkt: DenseLu::new(n + nc),
+            lu: DenseLu::new(nd + nc),
+            lu_kkt: DenseLu::new(nd + nc),
             massless: Vec::new(),
             first_order: vec![false; n],
             gamma: DVector::zeros(nc),
@@ -391,6 +484,17 @@ impl Work {
         st: &mut IntegrationStats,
     ) -> Result<(), SimError> {
         st.dynamics_evaluations += 1;
+        if let Some(b) = &mut self.block {
+            system.dynamics_blocks(
+                t,
+                self.q.as_slice(),
+                self.v.as_slice(),
+                &mut b.mass,
+                &mut self.force,
+            )?;
+            check_finite_blocks(t, "mass matrix M", &b.mass)?;
+            return check_finite(t, "force f", self.force.as_slice());
+        }
         system.dynamics(
             t,
             self.q.as_slice(),
@@ -450,6 +554,32 @@ impl Work {
             for k in 0..nc {
                 self.gamma[k] = (self.gp[k] - 2.0 * self.gval[k] + self.gamma[k]) / (s * s);
             }
+        }
+        if let Some(b) = &mut self.block {
+            // No constraints (a block pattern is used only without): M a = f
+            // by the bordered LU of M, its own workspace.
+            b.scratch.copy_from(&b.mass);
+            self.massless.clear();
+            for i in 0..n {
+                let first_order = system.is_first_order(i);
+                self.first_order[i] = first_order;
+                if first_order {
+                    self.massless.push(i);
+                    b.scratch.add(i, i, 1.0);
+                }
+            }
+            if b.lu_mass.factorize(&b.scratch).is_err() {
+                return Err(SimError::Diverged {
+                    t,
+                    reason: "cannot solve for the accelerations: mass matrix singular".into(),
+                });
+            }
+            self.a.copy_from(&self.force);
+            for &i in &self.massless {
+                self.a[i] = 0.0;
+            }
+            b.lu_mass.solve_vector(&mut self.a);
+            return check_finite(t, "acceleration q̈", self.a.as_slice());
         }
         // KKT system [[M, −Gᵀ], [G, 0]] (a, λ) = (f, −γ), in its own LU
         // workspace so the iteration matrix survives.
@@ -574,6 +704,9 @@ impl Work {
         let n = self.n;
         st.jacobian_evaluations += 1;
         st.dynamics_evaluations += 1;
+        if self.block.is_some() {
+            return self.evaluate_jacobian_blocks(system, kind, t, st);
+        }
         system.dynamics(
             t,
             self.q.as_slice(),
@@ -666,9 +799,129 @@ impl Work {
         Ok(())
     }
 
+    /// [`Work::evaluate_jacobian`] into the block matrices: the same
+    /// differences, with the columns of coordinates that touch disjoint rows
+    /// ([`BlockPattern::difference_groups`]) from one evaluation, and only
+    /// the entries the pattern holds (the others are zero by the structure).
+    fn evaluate_jacobian_blocks<S: MechanicalSystem + ?Sized>(
+        &mut self,
+        system: &mut S,
+        kind: JacobianKind,
+        t: f64,
+        st: &mut IntegrationStats,
+    ) -> Result<(), SimError> {
+        let Some(b) = self.block.as_mut() else {
+            return Ok(());
+        };
+        system.dynamics_blocks(
+            t,
+            self.q.as_slice(),
+            self.v.as_slice(),
+            &mut b.mass_j,
+            &mut self.f0,
+        )?;
+        check_finite_blocks(t, "mass matrix M", &b.mass_j)?;
+        check_finite(t, "force f", self.f0.as_slice())?;
+        if kind == JacobianKind::Analytic && self.analytic_ok {
+            if system.force_jacobian_blocks(
+                t,
+                self.q.as_slice(),
+                self.v.as_slice(),
+                &mut b.dfdq,
+                &mut b.dfdv,
+            )? {
+                check_finite_blocks(t, "Jacobian ∂f/∂q", &b.dfdq)?;
+                return check_finite_blocks(t, "Jacobian ∂f/∂q̇", &b.dfdv);
+            }
+            self.analytic_ok = false;
+        }
+        let central = kind == JacobianKind::CentralDifference;
+        let rel = if central {
+            f64::EPSILON.cbrt()
+        } else {
+            f64::EPSILON.sqrt()
+        };
+        b.dfdq.fill_zero();
+        b.dfdv.fill_zero();
+        // Columns by groups of the pattern (coordinates whose columns touch
+        // disjoint rows, perturbed together): a train's vehicles are
+        // differentiated at once, the border coordinates one by one.
+        let (mut steps_p, mut steps_m) = (Vec::new(), Vec::new());
+        for wrt_v in [false, true] {
+            let base = if wrt_v { &self.v } else { &self.q };
+            self.x_pert.copy_from(base);
+            for group in &b.groups {
+                steps_p.clear();
+                for &j in group {
+                    let xj = self.x_pert[j];
+                    self.x_pert[j] = xj + rel * xj.abs().max(1.0);
+                    steps_p.push(self.x_pert[j] - xj); // exactly representable increment
+                }
+                let (qs, vs) = if wrt_v {
+                    (&self.q, &self.x_pert)
+                } else {
+                    (&self.x_pert, &self.v)
+                };
+                st.dynamics_evaluations += 1;
+                system.dynamics_blocks(
+                    t,
+                    qs.as_slice(),
+                    vs.as_slice(),
+                    &mut b.mass_pert,
+                    &mut self.f_pert,
+                )?;
+                check_finite(t, "force f (Jacobian difference)", self.f_pert.as_slice())?;
+                let out = if wrt_v { &mut b.dfdv } else { &mut b.dfdq };
+                if central {
+                    steps_m.clear();
+                    for &j in group {
+                        let xj = base[j];
+                        self.x_pert[j] = xj - rel * xj.abs().max(1.0);
+                        steps_m.push(xj - self.x_pert[j]);
+                    }
+                    let (qs, vs) = if wrt_v {
+                        (&self.q, &self.x_pert)
+                    } else {
+                        (&self.x_pert, &self.v)
+                    };
+                    st.dynamics_evaluations += 1;
+                    system.dynamics_blocks(
+                        t,
+                        qs.as_slice(),
+                        vs.as_slice(),
+                        &mut b.mass_pert,
+                        &mut self.f_pert2,
+                    )?;
+                    check_finite(t, "force f (Jacobian difference)", self.f_pert2.as_slice())?;
+                    for ((&j, dp), dm) in group.iter().zip(&steps_p).zip(&steps_m) {
+                        for i in b.pattern.column_rows(j) {
+                            out.add(i, j, (self.f_pert[i] - self.f_pert2[i]) / (dp + dm));
+                        }
+                    }
+                } else {
+                    for (&j, dp) in group.iter().zip(&steps_p) {
+                        for i in b.pattern.column_rows(j) {
+                            out.add(i, j, (self.f_pert[i] - self.f0[i]) / dp);
+                        }
+                    }
+                }
+                for &j in group {
+                    self.x_pert[j] = base[j];
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Forms and factorizes the iteration matrix for `beta`. Returns `false`
     /// when it is singular.
     fn factor_iteration_matrix(&mut self, beta: f64, st: &mut IntegrationStats) -> bool {
+        if let Some(b) = &mut self.block {
+            b.scratch
+                .set_iteration_matrix(&b.mass_j, &b.dfdv, &b.dfdq, beta);
+            st.lu_factorizations += 1;
+            return b.lu.factorize(&b.scratch).is_ok();
+        }
         let (n, nc) = (self.n, self.nc);
         let b2 = beta * beta;
         let m = self.lu.matrix_mut();
@@ -829,7 +1082,15 @@ impl Work {
                 check_finite(t, "constraint Jacobian G", self.gjac.as_slice())?;
             }
             // rhs = [−β² (M a − f − Gᵀλ); −g]
-            {
+            if let Some(b) = &mut self.block {
+                // No constraints with a block pattern.
+                let top = &mut self.rhs.as_mut_slice()[..n];
+                b.mass.mul_to(self.a.as_slice(), top);
+                for (r, f) in top.iter_mut().zip(self.force.iter()) {
+                    *r = -b2 * (*r - f);
+                }
+                b.lu.solve_in_place(top);
+            } else {
                 let mut top = self.rhs.rows_mut(0, n);
                 top.gemv(1.0, &self.mass, &self.a, 0.0);
                 top -= &self.force;
@@ -837,11 +1098,11 @@ impl Work {
                     top.gemv_tr(-1.0, &self.gjac, &self.lam, 1.0);
                 }
                 top *= -b2;
+                for k in 0..nc {
+                    self.rhs[n + k] = -self.gval[k];
+                }
+                self.lu.solve_in_place(&mut self.rhs);
             }
-            for k in 0..nc {
-                self.rhs[n + k] = -self.gval[k];
-            }
-            self.lu.solve_in_place(&mut self.rhs);
             // Update and measure the correction.
             let mut sum = 0.0;
             let mut at_noise = true;
@@ -1102,7 +1363,14 @@ impl<S: MechanicalSystem> Park<S> {
         let n = system.dof();
         let nc = system.n_constraints();
         check_initial_state(n, t0, q0, v0)?;
-        let mut w = Work::new(n, nc);
+        // The block pattern, if asked for and usable (no constraints).
+        let pattern = match settings.solver {
+            LinearSolver::Block if nc == 0 => system
+                .block_pattern()
+                .filter(|p| p.dim() == n && !p.blocks().is_empty()),
+            _ => None,
+        };
+        let mut w = Work::new(n, nc, pattern.as_ref());
         let mut st = IntegrationStats::new(t0, n, nc);
         // Consistent initial state, accelerations and multipliers.
         w.q.copy_from_slice(q0);
@@ -1134,6 +1402,13 @@ impl<S: MechanicalSystem> Park<S> {
         };
         solver.record_state();
         Ok(solver)
+    }
+
+    /// Whether the linear systems are solved by the bordered block-diagonal
+    /// LU of the system's block pattern ([`LinearSolver::Block`] and a
+    /// pattern offered), else by the dense LU.
+    pub fn uses_block_solver(&self) -> bool {
+        self.work.block.is_some()
     }
 
     /// The settings.

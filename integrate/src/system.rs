@@ -10,7 +10,11 @@
 //! The integrators ([`crate::park`], [`crate::rk4`]) know nothing else about
 //! the model.
 
+use std::sync::Arc;
+
 use nalgebra::{DMatrix, DVector};
+
+use crate::block::{BlockMatrix, BlockPattern};
 
 /// Why an evaluation or a simulation failed. Always says where (time) and why.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -114,6 +118,75 @@ pub trait MechanicalSystem {
     fn remembers_accepted_steps(&self) -> bool {
         true
     }
+
+    /// The block structure of M, ∂f/∂q and ∂f/∂q̇, if the system has one
+    /// that pays ([`BlockPattern::pays`]): diagonal blocks coupled only
+    /// through border coordinates, as the system's elements couple them.
+    /// Park's method then assembles and factorizes its matrices blockwise
+    /// ([`crate::block`], [`crate::LinearSolver::Block`]) through
+    /// [`MechanicalSystem::dynamics_blocks`] and
+    /// [`MechanicalSystem::force_jacobian_blocks`]. `None` (the default):
+    /// dense matrices only.
+    fn block_pattern(&self) -> Option<Arc<BlockPattern>> {
+        None
+    }
+
+    /// [`MechanicalSystem::dynamics`] with M in the block form of
+    /// [`MechanicalSystem::block_pattern`] (`mass` comes with that pattern;
+    /// implementations overwrite every entry the pattern holds). The default
+    /// evaluates the dense M and copies its entries into the blocks.
+    fn dynamics_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut BlockMatrix,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        let n = self.dof();
+        let mut dense = DMatrix::zeros(n, n);
+        self.dynamics(t, q, v, &mut dense, force)?;
+        mass.fill_zero();
+        scatter_dense(&dense, mass);
+        Ok(())
+    }
+
+    /// [`MechanicalSystem::force_jacobian`] into the block form of
+    /// [`MechanicalSystem::block_pattern`] (overwriting every entry). The
+    /// default evaluates the dense Jacobians and copies their entries into
+    /// the blocks.
+    fn force_jacobian_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut BlockMatrix,
+        dfdv: &mut BlockMatrix,
+    ) -> Result<bool, SimError> {
+        let n = self.dof();
+        let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        if !self.force_jacobian(t, q, v, &mut dq, &mut dv)? {
+            return Ok(false);
+        }
+        dfdq.fill_zero();
+        dfdv.fill_zero();
+        scatter_dense(&dq, dfdq);
+        scatter_dense(&dv, dfdv);
+        Ok(true)
+    }
+}
+
+/// Adds the entries of the dense `m` that `out`'s pattern holds to `out`
+/// (entries outside the pattern, structurally zero, are skipped).
+fn scatter_dense(m: &DMatrix<f64>, out: &mut BlockMatrix) {
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            let x = m[(i, j)];
+            if x != 0.0 {
+                out.add(i, j, x);
+            }
+        }
+    }
 }
 
 /// A mutable reference integrates as the system itself (a solver can then
@@ -169,5 +242,31 @@ impl<S: MechanicalSystem + ?Sized> MechanicalSystem for &mut S {
 
     fn remembers_accepted_steps(&self) -> bool {
         (**self).remembers_accepted_steps()
+    }
+
+    fn block_pattern(&self) -> Option<Arc<BlockPattern>> {
+        (**self).block_pattern()
+    }
+
+    fn dynamics_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut BlockMatrix,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        (**self).dynamics_blocks(t, q, v, mass, force)
+    }
+
+    fn force_jacobian_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut BlockMatrix,
+        dfdv: &mut BlockMatrix,
+    ) -> Result<bool, SimError> {
+        (**self).force_jacobian_blocks(t, q, v, dfdq, dfdv)
     }
 }

@@ -34,6 +34,10 @@ pub struct ModelSystem {
     state_owners: Vec<(usize, usize, usize)>,
     /// Wheel loads of the last accepted step, for the run's assessment.
     accepted_loads: Vec<LoadSample>,
+    /// Per body: the coordinates its pose depends on (its own joint's and
+    /// its ancestors'), sorted: the structurally nonzero columns of its
+    /// Jacobian Γ.
+    body_coordinates: Vec<Vec<usize>>,
 }
 
 impl std::fmt::Debug for ModelSystem {
@@ -114,7 +118,16 @@ impl ModelSystem {
             state_rates: vec![0.0; n_states],
             state_owners,
             accepted_loads: Vec::new(),
+            body_coordinates: body_coordinates(model),
         })
+    }
+
+    /// The coordinates body `b`'s pose depends on (its own joint's and its
+    /// ancestors' in the model tree), sorted: the columns of its Jacobian Γ
+    /// that can be nonzero, hence the coordinates a force element on this
+    /// body couples.
+    pub fn body_coordinates(&self, b: usize) -> &[usize] {
+        &self.body_coordinates[b]
     }
 
     /// Connects the force elements that need the track (wheel–rail contact)
@@ -481,4 +494,28 @@ impl ModelSystem {
         }
         Ok(())
     }
+}
+
+/// Per body of `model`: the coordinates of its joint and its ancestors'
+/// joints, sorted (parents come before their children in the model).
+fn body_coordinates(model: &Model) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = Vec::with_capacity(model.bodies.len());
+    for (b, body) in model.bodies.iter().enumerate() {
+        let mut set = match body.parent {
+            railmbs_models::BodyRef::Body(p) if p < b => out[p].clone(),
+            _ => Vec::new(),
+        };
+        set.extend(
+            model
+                .coordinates
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.body == b)
+                .map(|(i, _)| i),
+        );
+        set.sort_unstable();
+        set.dedup();
+        out.push(set);
+    }
+    out
 }

@@ -38,12 +38,14 @@ use crate::run::{OutputSink, RowColumns, RunError, RunSummary, RunSystem, Runner
 use crate::system::{MechanicalSystem, SimError};
 use crate::track_inputs::RunningSpeed;
 use nalgebra::{DMatrix, DVector};
+use railmbs_integrate::{BlockMatrix, BlockPattern};
 use railmbs_models::{
     BodyRef, Expr, Frame, InitialStateKind, Model, TrainCoupler, TrainForce, TrainScenario,
 };
 use rayon::prelude::*;
 use std::ops::Range;
 use std::path::Path;
+use std::sync::Arc;
 
 /// A coupler: a force element of the model language between bodies of
 /// different vehicles (the runtime element of its spec, one home for each
@@ -184,6 +186,10 @@ pub struct TrainSystem {
     /// Whether the couplers' element states (stick anchors) have been set
     /// from an accepted state (the first evaluation sets them).
     couplers_initialized: bool,
+    /// The vehicles as diagonal blocks, the coordinates of the coupled
+    /// bodies as the border ([`MechanicalSystem::block_pattern`]); `None`
+    /// for a single vehicle or a vehicle without coordinates.
+    pattern: Option<Arc<BlockPattern>>,
 }
 
 /// Runs `f` on every item (vehicle `k` and its buffers), in vehicle order in
@@ -254,8 +260,24 @@ impl TrainSystem {
             n += s.dof();
             nc += s.n_constraints();
         }
+        // The border: every coordinate a coupler's body depends on (the
+        // columns of its Γ that can be nonzero); couplers couple vehicles
+        // through these alone.
+        let mut border = Vec::new();
+        for c in &couplers {
+            for &(k, b) in &c.bodies {
+                let start = ranges[k].start;
+                border.extend(systems[k].body_coordinates(b).iter().map(|&i| start + i));
+            }
+        }
+        let pattern = if ranges.len() > 1 && ranges.iter().all(|r| !r.is_empty()) {
+            Some(Arc::new(BlockPattern::new(ranges.clone(), border)?))
+        } else {
+            None
+        };
         let square = |s: &ModelSystem| DMatrix::zeros(s.dof(), s.dof());
         Ok(Self {
+            pattern,
             mass: systems.iter().map(square).collect(),
             force: systems.iter().map(|s| DVector::zeros(s.dof())).collect(),
             dq: systems.iter().map(square).collect(),
@@ -460,6 +482,147 @@ impl TrainSystem {
     }
 }
 
+impl TrainSystem {
+    /// Adds the couplers' generalized forces to `force` (the vehicles' last
+    /// evaluations give the bodies' kinematics and Jacobians).
+    fn add_coupler_forces(&mut self, t: f64, force: &mut DVector<f64>) -> Result<(), SimError> {
+        if !self.couplers_initialized {
+            self.accept_couplers(t)?;
+        }
+        for c in &self.couplers {
+            let bodies = self.coupler_bodies(c);
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+                states: &[],
+                state_rates: &[],
+            };
+            let mut w = vec![Wrench::default(); bodies.len()];
+            c.element.apply(&ctx, &mut w)?;
+            for (&(k, b), w) in c.bodies.iter().zip(&w) {
+                let r = self.ranges[k].clone();
+                add_generalized_force(
+                    &self.vehicles[k].last_evaluation().jacobians,
+                    b,
+                    w,
+                    &mut force.as_mut_slice()[r],
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds the couplers' Jacobians (local stiffness and damping mapped by
+    /// the Jacobians of both attachment points) through `add(i, j, ∂f_i/∂q_j,
+    /// ∂f_i/∂q̇_j)`, which returns `false` for an entry it has no place for.
+    fn add_coupler_jacobians(
+        &mut self,
+        t: f64,
+        mut add: impl FnMut(usize, usize, f64, f64) -> bool,
+    ) -> Result<(), SimError> {
+        for c in &self.couplers {
+            let bodies = self.coupler_bodies(c);
+            let ranges: Vec<Range<usize>> =
+                c.vehicles.iter().map(|&k| self.ranges[k].clone()).collect();
+            // Column offset of each of the coupler's vehicles.
+            let mut col0 = Vec::with_capacity(ranges.len());
+            let mut width = 0;
+            for r in &ranges {
+                col0.push(width);
+                width += r.len();
+            }
+            // Γ of the bodies stacked: rows 6i..6i+6 body i over its
+            // vehicle's columns.
+            let mut gamma = DMatrix::zeros(6 * c.bodies.len(), width);
+            for (i, &(k, b)) in c.bodies.iter().enumerate() {
+                let j = c.vehicles.iter().position(|&x| x == k).unwrap_or(0);
+                let src = &self.vehicles[k].last_evaluation().jacobians;
+                // The coordinates' columns; element states after them stay zero.
+                let n = ranges[j].len().min(src.ncols());
+                gamma
+                    .view_mut((6 * i, col0[j]), (6, n))
+                    .copy_from(&src.view((6 * b, 0), (6, n)));
+            }
+            let mut dq = DMatrix::zeros(width, width);
+            let mut dv = DMatrix::zeros(width, width);
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+                states: &[],
+                state_rates: &[],
+            };
+            let mut jac = ForceJacobian::new(&gamma, &bodies, &mut dq, &mut dv, &mut self.scratch);
+            c.element.add_jacobian(&ctx, &mut jac)?;
+            let global = |i: usize| {
+                let j = col0.iter().rposition(|&c0| c0 <= i).unwrap_or(0);
+                ranges[j].start + i - col0[j]
+            };
+            for a in 0..width {
+                for b in 0..width {
+                    let (x, y) = (dq[(a, b)], dv[(a, b)]);
+                    if (x != 0.0 || y != 0.0) && !add(global(a), global(b), x, y) {
+                        return Err(SimError::Other(format!(
+                            "coupler \"{}\": its Jacobian couples coordinates {} and {} \
+                             outside the train's block pattern",
+                            c.name,
+                            global(a),
+                            global(b)
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Evaluates the vehicles' approximate Jacobians into `dq[k]`, `dv[k]`
+    /// (one pair per vehicle); `false` if a vehicle has none (see
+    /// [`MechanicalSystem::force_jacobian`] of the train).
+    fn vehicle_jacobians(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dq: &mut [DMatrix<f64>],
+        dv: &mut [DMatrix<f64>],
+    ) -> Result<bool, SimError> {
+        // A vehicle without force elements of its own (a coupler vehicle,
+        // moved by the couplers only) has a zero approximate Jacobian
+        // (Eq. 31 neglects the inertia and gravity terms); any other vehicle
+        // without one makes the integrator differentiate the train.
+        let coupled: Vec<bool> = (0..self.vehicles.len())
+            .map(|k| self.couplers.iter().any(|c| c.vehicles.contains(&k)))
+            .collect();
+        let ranges = &self.ranges;
+        let mut items: Vec<_> = self
+            .vehicles
+            .iter_mut()
+            .zip(dq.iter_mut().zip(dv.iter_mut()))
+            .map(|x| (x, true))
+            .collect();
+        each_vehicle(self.pool.as_ref(), &mut items, |k, ((s, (dq, dv)), ok)| {
+            let r = ranges[k].clone();
+            *ok = s.force_jacobian(t, &q[r.clone()], &v[r.clone()], dq, dv)?;
+            if !*ok && coupled[k] && s.forces().is_empty() {
+                // Its body Jacobians at this state, for the couplers.
+                let parts = Parts {
+                    kinematics: true,
+                    jacobians: true,
+                    ..Parts::KINEMATICS
+                };
+                s.evaluate(t, &q[r.clone()], &v[r], parts)?;
+                dq.as_mut_slice().fill(0.0);
+                dv.as_mut_slice().fill(0.0);
+                *ok = true;
+            }
+            Ok(())
+        })?;
+        Ok(items.iter().all(|x| x.1))
+    }
+}
+
 impl MechanicalSystem for TrainSystem {
     fn dof(&self) -> usize {
         self.ranges.last().map_or(0, |r| r.end)
@@ -502,31 +665,7 @@ impl MechanicalSystem for TrainSystem {
                 .copy_from(&self.mass[k]);
             force.rows_mut(r.start, r.len()).copy_from(&self.force[k]);
         }
-        if !self.couplers_initialized {
-            self.accept_couplers(t)?;
-        }
-        for c in &self.couplers {
-            let bodies = self.coupler_bodies(c);
-            let ctx = ForceContext {
-                t,
-                bodies: &bodies,
-                params: &[],
-                states: &[],
-                state_rates: &[],
-            };
-            let mut w = vec![Wrench::default(); bodies.len()];
-            c.element.apply(&ctx, &mut w)?;
-            for (&(k, b), w) in c.bodies.iter().zip(&w) {
-                let r = self.ranges[k].clone();
-                add_generalized_force(
-                    &self.vehicles[k].last_evaluation().jacobians,
-                    b,
-                    w,
-                    &mut force.as_mut_slice()[r],
-                );
-            }
-        }
-        Ok(())
+        self.add_coupler_forces(t, force)
     }
 
     fn constraints(
@@ -566,41 +705,10 @@ impl MechanicalSystem for TrainSystem {
     ) -> Result<bool, SimError> {
         dfdq.as_mut_slice().fill(0.0);
         dfdv.as_mut_slice().fill(0.0);
-        // A vehicle without force elements of its own (a coupler vehicle,
-        // moved by the couplers only) has a zero approximate Jacobian
-        // (Eq. 31 neglects the inertia and gravity terms); any other vehicle
-        // without one makes the integrator differentiate the train.
-        let coupled: Vec<bool> = (0..self.vehicles.len())
-            .map(|k| self.couplers.iter().any(|c| c.vehicles.contains(&k)))
-            .collect();
-        let analytic: Vec<bool> = {
-            let ranges = &self.ranges;
-            let mut items: Vec<_> = self
-                .vehicles
-                .iter_mut()
-                .zip(self.dq.iter_mut().zip(self.dv.iter_mut()))
-                .map(|x| (x, true))
-                .collect();
-            each_vehicle(self.pool.as_ref(), &mut items, |k, ((s, (dq, dv)), ok)| {
-                let r = ranges[k].clone();
-                *ok = s.force_jacobian(t, &q[r.clone()], &v[r.clone()], dq, dv)?;
-                if !*ok && coupled[k] && s.forces().is_empty() {
-                    // Its body Jacobians at this state, for the couplers.
-                    let parts = Parts {
-                        kinematics: true,
-                        jacobians: true,
-                        ..Parts::KINEMATICS
-                    };
-                    s.evaluate(t, &q[r.clone()], &v[r], parts)?;
-                    dq.as_mut_slice().fill(0.0);
-                    dv.as_mut_slice().fill(0.0);
-                    *ok = true;
-                }
-                Ok(())
-            })?;
-            items.iter().map(|x| x.1).collect()
-        };
-        if analytic.contains(&false) {
+        let (mut dq, mut dv) = (std::mem::take(&mut self.dq), std::mem::take(&mut self.dv));
+        let ok = self.vehicle_jacobians(t, q, v, &mut dq, &mut dv);
+        (self.dq, self.dv) = (dq, dv);
+        if !ok? {
             return Ok(false);
         }
         for (k, r) in self.ranges.iter().enumerate() {
@@ -609,55 +717,68 @@ impl MechanicalSystem for TrainSystem {
             dfdv.view_mut((r.start, r.start), (r.len(), r.len()))
                 .copy_from(&self.dv[k]);
         }
-        for c in &self.couplers {
-            let bodies = self.coupler_bodies(c);
-            let ranges: Vec<Range<usize>> =
-                c.vehicles.iter().map(|&k| self.ranges[k].clone()).collect();
-            // Column offset of each of the coupler's vehicles.
-            let mut col0 = Vec::with_capacity(ranges.len());
-            let mut width = 0;
-            for r in &ranges {
-                col0.push(width);
-                width += r.len();
-            }
-            // Γ of the bodies stacked: rows 6i..6i+6 body i over its
-            // vehicle's columns.
-            let mut gamma = DMatrix::zeros(6 * c.bodies.len(), width);
-            for (i, &(k, b)) in c.bodies.iter().enumerate() {
-                let j = c.vehicles.iter().position(|&x| x == k).unwrap_or(0);
-                let src = &self.vehicles[k].last_evaluation().jacobians;
-                // The coordinates' columns; element states after them stay zero.
-                let n = ranges[j].len().min(src.ncols());
-                gamma
-                    .view_mut((6 * i, col0[j]), (6, n))
-                    .copy_from(&src.view((6 * b, 0), (6, n)));
-            }
-            let mut dq = DMatrix::zeros(width, width);
-            let mut dv = DMatrix::zeros(width, width);
-            let ctx = ForceContext {
-                t,
-                bodies: &bodies,
-                params: &[],
-                states: &[],
-                state_rates: &[],
-            };
-            let mut jac = ForceJacobian::new(&gamma, &bodies, &mut dq, &mut dv, &mut self.scratch);
-            c.element.add_jacobian(&ctx, &mut jac)?;
-            let global = |i: usize| {
-                let j = col0.iter().rposition(|&c0| c0 <= i).unwrap_or(0);
-                ranges[j].start + i - col0[j]
-            };
-            for a in 0..width {
-                for b in 0..width {
-                    if dq[(a, b)] != 0.0 {
-                        dfdq[(global(a), global(b))] += dq[(a, b)];
-                    }
-                    if dv[(a, b)] != 0.0 {
-                        dfdv[(global(a), global(b))] += dv[(a, b)];
-                    }
-                }
-            }
+        self.add_coupler_jacobians(t, |i, j, x, y| {
+            dfdq[(i, j)] += x;
+            dfdv[(i, j)] += y;
+            true
+        })?;
+        Ok(true)
+    }
+
+    /// The vehicles as diagonal blocks, the coordinates of the bodies that
+    /// couplers join as the border (from the model tree: a body's pose
+    /// depends on its own and its ancestors' coordinates); `None` for a
+    /// single vehicle or when the border is so large that the bordered
+    /// factorization would not save half of the dense work.
+    fn block_pattern(&self) -> Option<Arc<BlockPattern>> {
+        self.pattern.clone().filter(|p| p.pays())
+    }
+
+    /// [`MechanicalSystem::dynamics`] with each vehicle's M written straight
+    /// into its diagonal block (no n × n matrix cleared or copied).
+    fn dynamics_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        mass: &mut BlockMatrix,
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        {
+            let ranges = &self.ranges;
+            let mut items: Vec<_> = self
+                .vehicles
+                .iter_mut()
+                .zip(mass.blocks_mut().iter_mut().zip(self.force.iter_mut()))
+                .collect();
+            each_vehicle(self.pool.as_ref(), &mut items, |k, (s, (m, f))| {
+                let r = ranges[k].clone();
+                s.dynamics(t, &q[r.clone()], &v[r], m, f)
+            })?;
         }
+        for (k, r) in self.ranges.iter().enumerate() {
+            force.rows_mut(r.start, r.len()).copy_from(&self.force[k]);
+        }
+        self.add_coupler_forces(t, force)
+    }
+
+    /// [`MechanicalSystem::force_jacobian`] with each vehicle's Jacobians
+    /// written straight into its diagonal blocks and the couplers' entries
+    /// between vehicles into the border.
+    fn force_jacobian_blocks(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dfdq: &mut BlockMatrix,
+        dfdv: &mut BlockMatrix,
+    ) -> Result<bool, SimError> {
+        if !self.vehicle_jacobians(t, q, v, dfdq.blocks_mut(), dfdv.blocks_mut())? {
+            return Ok(false);
+        }
+        dfdq.clear_coupling();
+        dfdv.clear_coupling();
+        self.add_coupler_jacobians(t, |i, j, x, y| dfdq.add(i, j, x) && dfdv.add(i, j, y))?;
         Ok(true)
     }
 

@@ -200,5 +200,6 @@ pub(super) fn measure_model(args: &Args) -> Result<BenchReport, Box<dyn std::err
         compile_s,
         creep: args.creep.clone(),
         linear_ns,
+        train_linear: None,
     })
 }

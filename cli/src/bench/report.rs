@@ -57,6 +57,25 @@ pub struct BenchReport {
     /// factorization of an n×n iteration matrix and one Newton solve with
     /// it. `None` for a train (not measured) or when M could not be evaluated.
     pub linear_ns: Option<[f64; 3]>,
+    /// A train's linear solves, dense and bordered block-diagonal
+    /// ([`time_train_linear_solves`](super::train::time_train_linear_solves));
+    /// `None` for a model file or when they could not be set up.
+    pub train_linear: Option<TrainLinear>,
+}
+
+/// Park's linear solves of a train at its initial state, ns per call: the
+/// q̈ solve with M (dense Cholesky; the bordered LU of M), the LU
+/// factorization of the iteration matrix M − β ∂f/∂q̇ − β² ∂f/∂q and one
+/// Newton solve with it, dense and bordered block-diagonal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrainLinear {
+    /// Coordinates on the border (the coupled bodies').
+    pub border: usize,
+    /// Dense: q̈ solve, LU factorization, Newton solve.
+    pub dense_ns: [f64; 3],
+    /// Bordered block-diagonal: q̈ solve, factorization, Newton solve;
+    /// `None` when the train has no block pattern that pays.
+    pub block_ns: Option<[f64; 3]>,
 }
 
 fn ratio(a: Option<f64>, b: Option<f64>) -> Option<f64> {
@@ -109,6 +128,13 @@ impl BenchReport {
             "qdd_solve_ns": self.linear_ns.map(|t| t[0]),
             "lu_factorization_ns": self.linear_ns.map(|t| t[1]),
             "lu_solve_ns": self.linear_ns.map(|t| t[2]),
+            "train_border": self.train_linear.map(|t| t.border),
+            "train_dense_qdd_solve_ns": self.train_linear.map(|t| t.dense_ns[0]),
+            "train_dense_lu_factorization_ns": self.train_linear.map(|t| t.dense_ns[1]),
+            "train_dense_lu_solve_ns": self.train_linear.map(|t| t.dense_ns[2]),
+            "train_block_qdd_solve_ns": self.train_linear.and_then(|t| t.block_ns.map(|b| b[0])),
+            "train_block_factorization_ns": self.train_linear.and_then(|t| t.block_ns.map(|b| b[1])),
+            "train_block_solve_ns": self.train_linear.and_then(|t| t.block_ns.map(|b| b[2])),
             "numeric_note": self.numeric.note,
             "symbolic_note": self.symbolic.note,
         })
@@ -200,6 +226,30 @@ impl BenchReport {
                 "linear algebra (either engine): q̈ solve (Cholesky of M, solve) {chol:.1} ns; \
                  Park: LU factorization {factor:.1} ns, Newton solve {solve:.1} ns"
             );
+        }
+        if let Some(t) = &self.train_linear {
+            let [q, f, v] = t.dense_ns;
+            let _ = writeln!(
+                s,
+                "train linear algebra, dense: q̈ solve (Cholesky of M) {q:.1} ns; Park: LU \
+                 factorization {f:.1} ns, Newton solve {v:.1} ns"
+            );
+            match t.block_ns {
+                Some([q, f, v]) => {
+                    let _ = writeln!(
+                        s,
+                        "train linear algebra, block-bordered ({} border coordinates): q̈ solve \
+                         {q:.1} ns; Park: factorization {f:.1} ns, Newton solve {v:.1} ns",
+                        t.border
+                    );
+                }
+                None => {
+                    let _ = writeln!(
+                        s,
+                        "train linear algebra, block-bordered: no pattern that pays"
+                    );
+                }
+            }
         }
         if self.numeric.dynamics_ns.is_none() && self.numeric.eval_ns.is_some() {
             let _ = writeln!(

@@ -4,14 +4,14 @@
 //! vehicle on the same engine.
 
 use super::process::whole_process;
-use super::report::{BenchReport, EngineTimes};
-use super::timing::{Stopwatch, median_run};
+use super::report::{BenchReport, EngineTimes, TrainLinear};
+use super::timing::{Stopwatch, median_run, time_per_call};
 use super::workload::{random_states, time_engine};
 use super::{Args, BenchEngine, parse_creep};
 use crate::engine::{Engine, build_engine, build_engine_with};
 use railmbs_models::Model;
 use railmbs_runtime::Equations;
-use railmbs_runtime::train::run_train;
+use railmbs_runtime::train::{build_train, run_train};
 use std::path::Path;
 use std::time::Instant;
 
@@ -140,6 +140,7 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
     } else {
         (derive_s, compile_s) = (None, None);
     }
+    let train_linear = time_train_linear_solves(&train, &models).ok();
     let name = args
         .model
         .file_stem()
@@ -158,5 +159,115 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
         compile_s,
         creep: args.creep.clone(),
         linear_ns: None,
+        train_linear,
+    })
+}
+
+/// Park's linear solves of the train at its initial state (numeric
+/// engines): the q̈ solve with M, the factorization of the iteration matrix
+/// `M − β ∂f/∂q̇ − β² ∂f/∂q` (β = 0.6 ms, Park's β at a 1 ms step) and one
+/// Newton solve, dense and with the bordered block-diagonal LU, ns per call.
+/// Without an analytic Jacobian the iteration matrix is M alone.
+pub(super) fn time_train_linear_solves(
+    train: &railmbs_models::TrainScenario,
+    models: &[Model],
+) -> Result<TrainLinear, String> {
+    use nalgebra::{DMatrix, DVector};
+    use railmbs_runtime::MechanicalSystem;
+    use railmbs_runtime::integrate::linalg::{DenseLu, cholesky_in_place, cholesky_solve};
+    use railmbs_runtime::integrate::{BlockMatrix, BorderedLu};
+    let refs: Vec<&Model> = models.iter().collect();
+    let engines = models
+        .iter()
+        .map(|m| build_engine(m, Engine::Numeric, None).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut setup = build_train(train, &refs, engines).map_err(|e| e.to_string())?;
+    let sys = &mut setup.system;
+    let (q, v) = (&setup.q0, &setup.v0);
+    let n = sys.dof();
+    let err = |e: railmbs_runtime::SimError| e.to_string();
+    let mut mass = DMatrix::zeros(n, n);
+    let mut f = DVector::zeros(n);
+    sys.dynamics(0.0, q, v, &mut mass, &mut f).map_err(err)?;
+    let (mut dq, mut dv) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+    if !sys
+        .force_jacobian(0.0, q, v, &mut dq, &mut dv)
+        .map_err(err)?
+    {
+        dq.fill(0.0);
+        dv.fill(0.0);
+    }
+    let beta = 6e-4;
+    let a = &mass - &dv * beta - &dq * (beta * beta);
+    let rhs = DVector::from_element(n, 1.0);
+    let mut work = mass.clone();
+    let mut x = rhs.clone();
+    let singular = |what: &str| format!("the train's {what} is singular");
+    let chol = time_per_call(|_| {
+        work.copy_from(&mass);
+        x.copy_from(&rhs);
+        if !cholesky_in_place(&mut work) {
+            return Err(singular("mass matrix"));
+        }
+        cholesky_solve(&work, x.as_mut_slice());
+        std::hint::black_box(&x);
+        Ok(())
+    })?;
+    let mut lu = DenseLu::new(n);
+    let factor = time_per_call(|_| {
+        lu.matrix_mut().copy_from(&a);
+        lu.factorize().map_err(|_| singular("iteration matrix"))?;
+        std::hint::black_box(&lu);
+        Ok::<(), String>(())
+    })?;
+    let solve = time_per_call(|_| {
+        x.copy_from(&rhs);
+        lu.solve_in_place(&mut x);
+        std::hint::black_box(&x);
+        Ok::<(), String>(())
+    })?;
+    let Some(pattern) = sys.block_pattern() else {
+        return Ok(TrainLinear {
+            border: 0,
+            dense_ns: [chol, factor, solve],
+            block_ns: None,
+        });
+    };
+    let z = || BlockMatrix::zeros(&pattern);
+    let (mut mb, mut dqb, mut dvb, mut ab) = (z(), z(), z(), z());
+    sys.dynamics_blocks(0.0, q, v, &mut mb, &mut f)
+        .map_err(err)?;
+    if !sys
+        .force_jacobian_blocks(0.0, q, v, &mut dqb, &mut dvb)
+        .map_err(err)?
+    {
+        dqb.fill_zero();
+        dvb.fill_zero();
+    }
+    ab.set_iteration_matrix(&mb, &dvb, &dqb, beta);
+    let mut blu = BorderedLu::new(&pattern);
+    let block_qdd = time_per_call(|_| {
+        blu.factorize(&mb).map_err(|_| singular("mass matrix"))?;
+        x.copy_from(&rhs);
+        blu.solve_vector(&mut x);
+        std::hint::black_box(&x);
+        Ok::<(), String>(())
+    })?;
+    let block_factor = time_per_call(|_| {
+        blu.factorize(&ab)
+            .map_err(|_| singular("iteration matrix"))?;
+        std::hint::black_box(&blu);
+        Ok::<(), String>(())
+    })?;
+    let block_solve = time_per_call(|_| {
+        x.copy_from(&rhs);
+        blu.solve_vector(&mut x);
+        std::hint::black_box(&x);
+        Ok::<(), String>(())
+    })?;
+    Ok(TrainLinear {
+        border: pattern.border().len(),
+        dense_ns: [chol, factor, solve],
+        block_ns: Some([block_qdd, block_factor, block_solve]),
     })
 }

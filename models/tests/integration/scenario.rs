@@ -73,7 +73,8 @@ fn loads_every_field_and_resolves_paths() {
             atol: 1e-8,
             max_step: 0.01,
             initial_step: Some(1e-4),
-            jacobian: JacobianKind::Analytic
+            jacobian: JacobianKind::Analytic,
+            solver: Default::default(),
         }
     );
     assert_eq!(
@@ -135,7 +136,8 @@ fn optional_fields_have_defaults() {
             atol: 1e-8,
             max_step: 0.01,
             initial_step: None,
-            jacobian: JacobianKind::FiniteDifference
+            jacobian: JacobianKind::FiniteDifference,
+            solver: Default::default(),
         }
     );
 }

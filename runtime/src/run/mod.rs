@@ -27,7 +27,7 @@ use crate::integrate::{self, IntegrationStats, Park, ParkSettings, Rk4, Rk4Setti
 use crate::model_system::ModelSystem;
 use crate::system::{MechanicalSystem, SimError};
 use grid::{OutputSchedule, PendingRows, Row};
-use railmbs_models::{IntegratorSpec, JacobianKind, Model, Scenario};
+use railmbs_models::{IntegratorSpec, JacobianKind, LinearSolverKind, Model, Scenario};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -270,8 +270,13 @@ fn solver<'s, S: MechanicalSystem>(
             max_step,
             initial_step,
             jacobian,
+            solver,
         } => {
             let mut settings = ParkSettings::with_tolerances(*rtol, *atol);
+            settings.solver = match solver {
+                LinearSolverKind::Dense => integrate::LinearSolver::Dense,
+                LinearSolverKind::Block => integrate::LinearSolver::Block,
+            };
             settings.max_step = *max_step;
             settings.initial_step = *initial_step;
             settings.jacobian = match jacobian {

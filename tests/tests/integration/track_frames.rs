@@ -155,6 +155,7 @@ fn tc1_free_body_error(tol: f64) -> (f64, usize) {
         max_step: 0.05,
         initial_step: None,
         jacobian: railmbs_models::JacobianKind::FiniteDifference,
+        solver: Default::default(),
     };
     let model = railmbs_models::load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     let dir = tempfile::tempdir().unwrap();

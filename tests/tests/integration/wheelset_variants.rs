@@ -51,6 +51,7 @@ fn tight_park() -> IntegratorSpec {
         max_step: 0.005,
         initial_step: None,
         jacobian: Default::default(),
+        solver: Default::default(),
     }
 }
 
@@ -486,6 +487,7 @@ fn bounce(path: &str, extra: &[(&str, &str)], z0: Option<f64>, max_step: f64) ->
             max_step,
             initial_step: None,
             jacobian: Default::default(),
+            solver: Default::default(),
         };
     })
 }

@@ -453,6 +453,7 @@ fn coasting_balance(mut scenario: railmbs_models::Scenario, t0: f64) -> (f64, f6
         max_step: 0.002,
         initial_step: None,
         jacobian: railmbs_models::JacobianKind::Analytic,
+        solver: Default::default(),
     };
     scenario.output.interval = 0.002;
     energy_balance(scenario, t0)
