@@ -244,7 +244,7 @@ impl BlockMatrix {
     }
 
     /// The entries between blocks: entry (a, b) is the matrix entry
-    /// (border[a], border[b]) for border coordinates of different blocks;
+    /// `(border[a], border[b])` for border coordinates of different blocks;
     /// entries of coordinates in the same block must stay zero here.
     pub fn coupling(&self) -> &DMatrix<f64> {
         &self.coupling
@@ -740,7 +740,8 @@ mod tests {
         let (dense, block) = train.factorization_work();
         assert!(train.pays() && block < 0.2 * dense, "{block} vs {dense}");
         // One block: nothing to gain.
-        let one = BlockPattern::new(Vec::from([0..10]), vec![]).unwrap();
+        let one_range: Vec<std::ops::Range<usize>> = std::iter::once(0..10).collect();
+        let one = BlockPattern::new(one_range, vec![]).unwrap();
         assert!(!one.pays());
     }
 }

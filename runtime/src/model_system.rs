@@ -202,7 +202,7 @@ impl ModelSystem {
     /// stick anchor, no friction mode, no accepted rail state) until the
     /// next accepted step, instead of accepting the state of the first
     /// evaluation. The static equilibrium is solved so
-    /// ([`crate::run::scenario_system`]): accepted at the initial guess, a
+    /// ([`crate::run::scenario::scenario_system`]): accepted at the initial guess, a
     /// contact or friction element would stick there, and its anchor would
     /// hold whatever force the settling to the equilibrium puts on it (up to
     /// the static limit), an equilibrium the element forgets at the next
