@@ -58,7 +58,7 @@ pub struct BenchReport {
     /// it. `None` for a train (not measured) or when M could not be evaluated.
     pub linear_ns: Option<[f64; 3]>,
     /// A train's linear solves, dense and bordered block-diagonal
-    /// ([`time_train_linear_solves`](super::train::time_train_linear_solves));
+    /// (`time_train_linear_solves` in the bench's train module);
     /// `None` for a model file or when they could not be set up.
     pub train_linear: Option<TrainLinear>,
 }
