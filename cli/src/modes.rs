@@ -7,12 +7,16 @@
 //! lateral (hunting) mode's damping ratio crosses zero; `--plot FILE` draws
 //! that mode's damping ratio and frequency against speed. `--sweep
 //! NAME=FROM:TO:STEP` is the same over a model parameter at the scenario's
-//! speed (a conicity-setting parameter, a suspension stiffness).
+//! speed (a suspension stiffness); `--conicity FROM:TO:STEP` over the
+//! equivalent conicity of the wheel–rail contacts (the classical
+//! quasi-linear analysis), and with `--speed` the linear critical speed at
+//! each conicity.
 
 use crate::engine::EngineOptions;
 use railmbs_runtime::analysis::modes::Mode;
 use railmbs_runtime::analysis::speed::{
-    SpeedModes, critical_speed, parameter_locus, root_locus, scenario_modes,
+    CriticalAtConicity, SpeedModes, conicity_locus, critical_speed, critical_speed_over_conicity,
+    parameter_locus, root_locus, scenario_modes,
 };
 use railmbs_runtime::forces::ContactTableCache;
 use railmbs_runtime::run::RunError;
@@ -34,6 +38,14 @@ pub struct Args {
     /// least damped lateral mode's damping ratio crosses zero.
     #[arg(long, value_name = "NAME=FROM:TO:STEP", value_parser = parse_sweep, conflicts_with = "speed")]
     pub sweep: Option<(String, Speeds)>,
+    /// The classical quasi-linear analysis: a locus over the equivalent
+    /// conicity `FROM:TO:STEP` (–) of every wheel–rail contact (the
+    /// profiles' geometry scaled in the lateral shift so that ½ dΔr/dy at
+    /// the centre is λ; the contact angles' and the roll's slopes scaled
+    /// alike), at the scenario's speed; with `--speed`, the linear critical
+    /// speed at each conicity (a root locus per conicity).
+    #[arg(long, value_name = "FROM:TO:STEP", value_parser = parse_conicities, conflicts_with = "sweep")]
+    pub conicity: Option<Speeds>,
     /// CSV: the modes with their shapes, or with `--speed` the root locus.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -71,6 +83,18 @@ pub(crate) fn parse_speeds(text: &str) -> Result<Speeds, String> {
         .map_err(|e| format!("{text:?}: {e}"))
 }
 
+/// The conicities of `--conicity FROM:TO:STEP` (–, FROM > 0).
+fn parse_conicities(text: &str) -> Result<Speeds, String> {
+    let values =
+        parse_speeds(text).map_err(|e| e.replace("(m/s)", "(–)").replace(" in m/s", ""))?;
+    if values.0.first().is_some_and(|&x| x <= 0.0) {
+        return Err(format!(
+            "{text:?}: an equivalent conicity must be positive (FROM > 0)"
+        ));
+    }
+    Ok(values)
+}
+
 /// `NAME=FROM:TO:STEP` of `--sweep` (FROM ≥ 0 as for speeds).
 fn parse_sweep(text: &str) -> Result<(String, Speeds), String> {
     match text.split_once('=') {
@@ -100,9 +124,41 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     if let Some(p) = &args.plot {
         crate::plot::Format::of(p)?;
-        if args.speed.is_none() && args.sweep.is_none() {
-            return Err("--plot needs --speed or --sweep (a locus to plot)".into());
+        if args.speed.is_none() && args.sweep.is_none() && args.conicity.is_none() {
+            return Err("--plot needs --speed, --sweep or --conicity (a locus to plot)".into());
         }
+    }
+    if let Some(Speeds(conicities)) = &args.conicity {
+        let start = std::time::Instant::now();
+        let axis = Axis {
+            label: "conicity[-]",
+            values: conicities,
+        };
+        if let Some(Speeds(speeds)) = &args.speed {
+            let table =
+                critical_speed_over_conicity(&scenario, &model, conicities, speeds, &mut make)?;
+            let total = start.elapsed().as_secs_f64();
+            print!("{}", describe_critical_over(&table, speeds, total)?);
+            if let Some(path) = &args.output {
+                write_critical_over(path, &table)?;
+                println!("critical speeds written to {}", path.display());
+            }
+            if let Some(plot) = &args.plot {
+                plot_critical_over(plot, args.output.as_deref(), &table)?;
+            }
+            return Ok(());
+        }
+        let locus = conicity_locus(&scenario, &model, conicities, &mut make)?;
+        let total = start.elapsed().as_secs_f64();
+        print!("{}", describe_locus_over(&locus, &axis, total)?);
+        if let Some(path) = &args.output {
+            write_locus_over(path, &locus, &axis)?;
+            println!("locus written to {}", path.display());
+        }
+        if let Some(plot) = &args.plot {
+            plot_locus_over(plot, args.output.as_deref(), &locus, &axis)?;
+        }
+        return Ok(());
     }
     if let Some((name, Speeds(values))) = &args.sweep {
         let start = std::time::Instant::now();
@@ -297,6 +353,98 @@ pub fn describe_locus(locus: &[SpeedModes], seconds: f64) -> Result<String, std:
         )?,
     }
     Ok(s)
+}
+
+/// The linear critical speeds over the equivalent conicity: one line per
+/// conicity.
+pub fn describe_critical_over(
+    table: &[CriticalAtConicity],
+    speeds: &[f64],
+    seconds: f64,
+) -> Result<String, std::fmt::Error> {
+    let mut s = String::new();
+    let (from, to) = (
+        speeds.first().unwrap_or(&0.0),
+        speeds.last().unwrap_or(&0.0),
+    );
+    writeln!(
+        s,
+        "linear critical speed over the equivalent conicity: {} conicities × {} speeds \
+         ({from} to {to} m/s) in {seconds:.2} s\n\nconicity[-]  critical speed [m/s]  [km/h]",
+        table.len(),
+        speeds.len(),
+    )?;
+    for (x, v, _) in table {
+        match v {
+            Some(v) => writeln!(s, "{x:>11.5}  {v:>20.3}  {:>6.1}", 3.6 * v)?,
+            None => writeln!(s, "{x:>11.5}  {:>20}", "not in the range")?,
+        }
+    }
+    Ok(s)
+}
+
+/// The critical speeds over the conicity as CSV: `conicity[-]`,
+/// `critical_speed[m/s]` (empty where none is in the speed range).
+fn write_critical_over(
+    path: &std::path::Path,
+    table: &[CriticalAtConicity],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
+    w.write_record(["conicity[-]", "critical_speed[m/s]"])
+        .map_err(|e| csv_error(path, e))?;
+    for (x, v, _) in table {
+        w.write_record([
+            format!("{x:?}"),
+            v.map_or(String::new(), |v| format!("{v:?}")),
+        ])
+        .map_err(|e| csv_error(path, e))?;
+    }
+    w.flush().map_err(|e| csv_error(path, e))?;
+    Ok(())
+}
+
+/// The plot of the critical speed against the conicity (`umsim plot` of a
+/// CSV beside it, the conicities with a critical speed in the range).
+fn plot_critical_over(
+    plot: &std::path::Path,
+    output: Option<&std::path::Path>,
+    table: &[CriticalAtConicity],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let csv = plot.with_extension("csv");
+    if output == Some(csv.as_path()) {
+        return Err(format!(
+            "--plot {} would write its data over the -o file {}",
+            plot.display(),
+            csv.display()
+        )
+        .into());
+    }
+    let found: Vec<CriticalAtConicity> = table
+        .iter()
+        .filter(|(_, v, _)| v.is_some())
+        .map(|(x, v, _)| (*x, *v, Vec::new()))
+        .collect();
+    if found.is_empty() {
+        return Err("--plot: no conicity has a linear critical speed in the speed range".into());
+    }
+    write_critical_over(&csv, &found)?;
+    crate::plot::run(&crate::plot::Args {
+        input: csv.clone(),
+        y: vec!["critical_speed[m/s]".into()],
+        x: "conicity[-]".into(),
+        from: None,
+        to: None,
+        title: Some("linear critical speed against the equivalent conicity".into()),
+        width: 1000,
+        height: None,
+        output: plot.to_path_buf(),
+    })?;
+    println!(
+        "critical-speed plot written to {} (data {})",
+        plot.display(),
+        csv.display()
+    );
+    Ok(())
 }
 
 fn csv_error(path: &std::path::Path, e: impl std::fmt::Display) -> String {

@@ -132,12 +132,20 @@ pub struct ScenarioTrack {
     /// The track itself, read from `file`, validated and built when the
     /// scenario is loaded (with its measured irregularities, if any).
     pub track: Arc<Track>,
+    /// The equivalent conicity override of the quasi-linear analyses (–):
+    /// every wheel–rail contact's geometry scaled in the lateral shift so
+    /// that its central conicity is this (the runtime's wheel–rail element,
+    /// "Conicity override"); `None` (the default, and what scenario files
+    /// give) for the profiles' own geometry. Set by `umsim modes
+    /// --conicity`.
+    pub conicity: Option<f64>,
 }
 
 impl ScenarioTrack {
     /// Puts the scenario on the track of `file` instead (read, parsed and built
     /// as when the scenario loads; `file` replaces [`ScenarioTrack::file`]).
     pub fn load_file(&mut self, file: &Path) -> Result<(), ModelErrors> {
+        let conicity = self.conicity;
         *self = PendingTrack {
             file: file.to_path_buf(),
             start: self.start,
@@ -145,6 +153,7 @@ impl ScenarioTrack {
             speed_profile: self.speed_profile.clone(),
         }
         .load()?;
+        self.conicity = conicity;
         Ok(())
     }
 }
@@ -169,6 +178,7 @@ impl PendingTrack {
             speed: self.speed,
             speed_profile: self.speed_profile,
             track: Arc::new(track),
+            conicity: None,
         })
     }
 }

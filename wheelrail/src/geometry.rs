@@ -1275,6 +1275,33 @@ impl ContactTable {
         }
         Ok(out)
     }
+
+    /// The linear (small-amplitude) equivalent conicity of the profiles about
+    /// the centred wheelset (–): λ = ½ dΔr/dy at y = 0 by the central
+    /// difference of the rigid contact functions ([`Self::rigid_functions`]:
+    /// the exact contact geometry, the roll following the shift) at the
+    /// table's two lateral nodes next to the centre, ±`dy`; Δr the
+    /// rolling radius difference of the deepest contacts. It is the limit of
+    /// EN 15302's equivalent conicity ([`crate::conicity`], with the rigid
+    /// wheelset's roll) as the amplitude goes to zero where Δr is linear, so
+    /// that the kinematic wavelength of Klingel's linear wheelset is
+    /// 2π √(r0 e / λ). An error if the table has no node on each side of the
+    /// centre.
+    pub fn central_conicity(&self) -> Result<f64, GeometryError> {
+        let ic = (self.ny - 1) / 2;
+        if self.ny < 3 {
+            return Err(invalid(
+                "table for the central conicity",
+                format!(
+                    "{} lateral node(s): needs one on each side of the centre",
+                    self.ny
+                ),
+            ));
+        }
+        let dr = |i: usize| self.rigid[i].rolling_radius_difference();
+        let (yp, ym) = (self.rigid[ic + 1].y, self.rigid[ic - 1].y);
+        Ok(0.5 * (dr(ic + 1) - dr(ic - 1)) / (yp - ym))
+    }
 }
 
 /// The tread/flange split of one side from the rigid contact sweep (see

@@ -1,6 +1,7 @@
 //! A scenario's modes at its running speed and over a range of speeds (the
-//! root locus), and the linear critical speed: at each speed the steady
-//! state on the scenario's track ([`super::equilibrium`]), the
+//! root locus), over a model parameter or the equivalent conicity (the
+//! classical quasi-linear analysis), and the linear critical speed: at
+//! each speed the steady state on the scenario's track ([`super::equilibrium`]), the
 //! linearization there ([`super::linear`]) and its modes
 //! ([`super::modes`]).
 
@@ -172,15 +173,119 @@ pub fn parameter_locus(
             ),
         });
     }
+    locus_over(scenario, model, values, engine, &|s, x| {
+        s.set_parameter(name, &format!("{x:?}"));
+        format!("{name} = {x}")
+    })
+}
+
+/// `scenario` with its wheel–rail contacts' equivalent conicity overridden
+/// to `conicity` (–; [`railmbs_models::ScenarioTrack::conicity`], the
+/// wheel–rail element's "Conicity override"), its steady state sought
+/// from the model's reference state: the scenario's `initial` entries are
+/// dropped, since the scaled geometry moves a given offset s = λ/λ₀ times
+/// further across the profiles (a hunting scenario's 3 mm kick at s = 3
+/// starts the solve on the flange); a scenario without a track is returned
+/// as it is (it has no wheel–rail contact).
+pub fn at_conicity(scenario: &Scenario, conicity: f64) -> Scenario {
+    let mut s = scenario.clone();
+    if let Some(track) = &mut s.track {
+        track.conicity = Some(conicity);
+        s.initial.clear();
+    }
+    s
+}
+
+/// The modes of `scenario` (at its own speed) for each equivalent conicity
+/// of `conicities` (–, [`at_conicity`]): the classical quasi-linear
+/// analysis over λ, each from its own steady state; `engine` makes a fresh
+/// engine for each (the contact tables are built once: the override scales
+/// the lookup, not the table).
+///
+/// # Errors
+/// A scenario without a track, a conicity not positive, or as
+/// [`scenario_modes`], naming the conicity.
+pub fn conicity_locus(
+    scenario: &Scenario,
+    model: &Model,
+    conicities: &[f64],
+    engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
+) -> Result<Vec<SpeedModes>, RunError> {
+    need_track(scenario)?;
+    locus_over(scenario, model, conicities, engine, &|s, x| {
+        *s = at_conicity(s, x);
+        format!("equivalent conicity {x}")
+    })
+}
+
+/// One equivalent conicity's (–) linear critical speed (m/s; `None` where
+/// none is in the speed range) and root locus.
+pub type CriticalAtConicity = (f64, Option<f64>, Vec<SpeedModes>);
+
+/// The linear critical speed (m/s, [`critical_speed`]) of `scenario` at
+/// each equivalent conicity of `conicities` (–): a root locus over
+/// `speeds` (m/s, [`root_locus`]) per conicity; `None` where the least
+/// damped lateral mode's damping ratio does not cross zero in `speeds`.
+/// The loci come back with them.
+///
+/// # Errors
+/// As [`conicity_locus`] and [`root_locus`].
+pub fn critical_speed_over_conicity(
+    scenario: &Scenario,
+    model: &Model,
+    conicities: &[f64],
+    speeds: &[f64],
+    engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
+) -> Result<Vec<CriticalAtConicity>, RunError> {
+    need_track(scenario)?;
+    conicities
+        .iter()
+        .map(|&x| {
+            let locus =
+                root_locus(&at_conicity(scenario, x), model, speeds, engine).map_err(|e| {
+                    RunError::Setup {
+                        file: scenario.source.clone(),
+                        message: format!("at equivalent conicity {x}: {e}"),
+                    }
+                })?;
+            Ok((x, critical_speed(&locus), locus))
+        })
+        .collect()
+}
+
+/// A scenario without a track as the error of a conicity analysis.
+fn need_track(scenario: &Scenario) -> Result<(), RunError> {
+    if scenario.track.is_none() {
+        return Err(RunError::Setup {
+            file: scenario.source.clone(),
+            message: "--conicity: the scenario has no track, hence no wheel–rail contact whose \
+                      conicity could be set"
+                .into(),
+        });
+    }
+    Ok(())
+}
+
+/// The one sweep of the loci over a variable: for each of `values`,
+/// `apply` sets it on a copy of `scenario` (and names it for errors), and
+/// its modes come from [`scenario_modes`] with a fresh engine from
+/// `engine`, the contact tables shared.
+fn locus_over(
+    scenario: &Scenario,
+    model: &Model,
+    values: &[f64],
+    engine: &mut dyn FnMut() -> Result<Box<dyn Equations>, RunError>,
+    apply: &dyn Fn(&mut Scenario, f64) -> String,
+) -> Result<Vec<SpeedModes>, RunError> {
     let tables = ContactTableCache::new();
     values
         .iter()
         .map(|&x| {
             let mut s = scenario.clone();
-            s.set_parameter(name, &format!("{x:?}"));
+            let what = apply(&mut s, x);
             scenario_modes(&s, model, engine()?, &tables).map_err(|e| RunError::Setup {
                 file: scenario.source.clone(),
-                message: format!("at {name} = {x}: {e}"),
+                message: format!("at {what}: {e}"),
             })
         })
         .collect()

@@ -107,6 +107,7 @@ pub(crate) fn drive_track_frames(
         speed,
         body_offsets,
         tables: tables.clone(),
+        conicity: spec.conicity,
     };
     Ok((
         Box::new(DrivenEquations::new(equations, Box::new(inputs))?),

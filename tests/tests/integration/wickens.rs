@@ -18,7 +18,7 @@ use nalgebra::Matrix4;
 use railmbs_models::{CreepLawSpec, ForceKind, InitialStateKind, Model, Scenario};
 use railmbs_runtime::NumericEquations;
 use railmbs_runtime::analysis::modes::Mode;
-use railmbs_runtime::analysis::speed::{at_speed, scenario_modes};
+use railmbs_runtime::analysis::speed::{at_conicity, at_speed, scenario_modes};
 use railmbs_runtime::forces::ContactTableCache;
 use railmbs_testkit::*;
 use railmbs_wheelrail::geometry::{ContactGeometry, RigidContact, SearchSettings, Track, Wheelset};
@@ -406,4 +406,148 @@ fn a_free_wheelset_oscillates_at_klingels_kinematic_frequency() {
         // (ζ = 0 in Klingel's limit).
         assert!(full.damping_ratio.abs() < 0.01, "{full:?}");
     }
+}
+
+/// The conicity override (`umsim modes --conicity`; the wheel–rail
+/// element's "Conicity override": the contact geometry looked up at the
+/// shift s y, s = λ/λ₀): the free wheelset of
+/// [`a_free_wheelset_oscillates_at_klingels_kinematic_frequency`] at the
+/// equivalent conicities 0.05, 0.1, 0.2 and 0.3 oscillates at Klingel's
+/// f = V/(2π) √(λ/(r0 e)) with λ the override itself (r0, e from the
+/// profiles' rigid contact as above: the override keeps them).
+///
+/// Klingel's formula neglects the wheelset's roll; the override scales the
+/// roll that follows the shift by s with everything else, and the contacts
+/// r0 below the axle then move laterally by r0 θ̇ besides ẏ: the kinematic
+/// relation ẏ (1 + r0 s dθ/dy) = V ψ lowers the frequency by
+/// (1 + r0 s dθ/dy)^(−1/2) (0.33 % at λ = 0.05, 1.3 % at λ = 0.2 here;
+/// dθ/dy from the rigid contact). With it the full model lies a constant
+/// +0.45 % above at every conicity and speed (speed-independent, so
+/// kinematic: the table's interpolation of the rolling radii against the
+/// rigid contact's central difference, as in the unscaled test, which
+/// sees the same offset once the roll is counted). Tolerance 0.6 %.
+#[test]
+fn a_free_wheelset_at_an_overridden_conicity_oscillates_at_klingels_frequency() {
+    let (mut s, model) = soft_wheelset(Some(CreepLawSpec::Kalker));
+    for (name, value) in [
+        ("kx", "1e3"),
+        ("ky", "0"),
+        ("cx", "0"),
+        ("cy", "0"),
+        ("y0", "0"),
+    ] {
+        s.set_parameter(name, value);
+    }
+    let susp = suspension(&model, &s);
+    let w = wheelset_contact(susp.q, 1e-4);
+    println!(
+        "the profiles' own conicity (rigid contact, ±0.1 mm): {:.5}",
+        w.conicity
+    );
+    for lambda in [0.05, 0.1, 0.2, 0.3] {
+        let scaled = at_conicity(&s, lambda);
+        for v in [2.0, 5.0] {
+            let full = full_hunting(&scaled, &model, v);
+            // The roll that follows the shift (θ = s dθ/dy y) moves the
+            // contacts, r0 below the axle, laterally by r0 θ (a rotation
+            // about x of the point z = −r0): the kinematic relation is
+            // ẏ (1 + r0 s dθ/dy) = V ψ, and Klingel's ω² divides by that.
+            let roll = 1.0 + w.r0 * (lambda / w.conicity) * w.d_roll;
+            let klingel = v / (2.0 * std::f64::consts::PI) * (lambda / (w.r0 * w.e * roll)).sqrt();
+            println!(
+                "λ = {lambda}, V = {v} m/s: full {:.5} Hz, Klingel with the roll {klingel:.5} Hz ({:+.3} %)",
+                full.frequency,
+                100.0 * (full.frequency / klingel - 1.0)
+            );
+            assert!(
+                (full.frequency - klingel).abs() < 6e-3 * klingel,
+                "λ = {lambda}, {v} m/s: {} Hz, Klingel {klingel} Hz",
+                full.frequency
+            );
+            assert!(full.damping_ratio.abs() < 0.01, "{full:?}");
+        }
+    }
+}
+
+/// The wheelset on soft springs of
+/// [`wheelset_on_springs_hunts_as_wickens_linear_wheelset`] at the
+/// overridden equivalent conicity 0.1 (s = λ/λ_profiles = 0.88) hunts as
+/// Wickens' linear wheelset with λ the override and the contact angles'
+/// slopes (hence the gravitational stiffness and the spin terms) scaled by
+/// s, as the override defines them; frequency, damping ratio and critical
+/// speed, with the tolerances of the unscaled comparison (frequency 1.5 %,
+/// damping ratio 0.012, critical speed 4 %: the residual there is the net
+/// lateral stiffness kg − ks, a difference of two large terms, as the
+/// 6-DOF model sees it against the 2-DOF model, and at s ≤ 1 it is no
+/// larger).
+///
+/// At λ = 0.2 (s = 1.75) only the frequency is held to Wickens' (1.5 %,
+/// found 1.2 %) and the critical speed must fall (Wickens: V_c ∝ 1/√λ for
+/// the dominant creep terms): a check that the override moves it. The
+/// damping ratio (0.008 to 0.013 below Wickens') and the critical speed
+/// (38.4 against 40.3 m/s, 4.9 %) are printed, not held: the residual
+/// grows with s (the roll that follows the shift, scaled by s, adds
+/// r0 s dθ/dy ẏ to the contacts' lateral velocity, which Wickens' model
+/// omits; see the free wheelset's test), a limit of the comparison, not
+/// of the override, which the free wheelset's kinematic test checks
+/// exactly.
+#[test]
+fn wheelset_on_springs_at_an_overridden_conicity_hunts_as_wickens_wheelset() {
+    let (mut s, model) = soft_wheelset(Some(CreepLawSpec::Kalker));
+    // The equilibrium's guess centred: the scenario's 3 mm start (for its
+    // decelerating run) is, scaled by s ≈ 2 at λ = 0.3, beyond the
+    // profiles' tread (the Newton solve then does not reach the centre).
+    s.set_parameter("y0", "0");
+    let susp = suspension(&model, &s);
+    let real = wheelset_contact(susp.q, 1e-4);
+    let mut critical = Vec::new();
+    for (lambda, speeds) in [
+        (0.1, [40.0, 50.0, 60.0, 70.0, 80.0]),
+        (0.2, [24.0, 32.0, 40.0, 48.0, 56.0]),
+    ] {
+        let ratio = lambda / real.conicity;
+        let w = WheelsetContact {
+            conicity: lambda,
+            d_delta: real.d_delta * ratio,
+            d_tan_delta: real.d_tan_delta * ratio,
+            ..wheelset_contact(susp.q, 1e-4)
+        };
+        let scaled = at_conicity(&s, lambda);
+        let (mut full_zeta, mut wickens_zeta) = (vec![], vec![]);
+        for v in speeds {
+            let full = full_hunting(&scaled, &model, v);
+            let (f, zeta) =
+                frequency_and_damping(oscillating(&wickens_matrix(v, &w, &susp, true))[0]);
+            println!(
+                "λ = {lambda}, V = {v} m/s: full {:.4} Hz, ζ = {:.4}; Wickens {f:.4} Hz, ζ = {zeta:.4}",
+                full.frequency, full.damping_ratio
+            );
+            assert!(
+                (full.frequency - f).abs() < 0.015 * f,
+                "λ = {lambda}, {v} m/s: {} Hz, Wickens {f} Hz",
+                full.frequency
+            );
+            assert!(
+                lambda > 0.15 || (full.damping_ratio - zeta).abs() < 0.012,
+                "λ = {lambda}, {v} m/s: ζ = {}, Wickens {zeta}",
+                full.damping_ratio
+            );
+            full_zeta.push((v, full.damping_ratio));
+            wickens_zeta.push((v, zeta));
+        }
+        let crossing = railmbs_runtime::analysis::modes::zero_crossing;
+        let (full_vc, wickens_vc) = (
+            crossing(&full_zeta).unwrap_or_else(|| panic!("λ = {lambda}: {full_zeta:?}")),
+            crossing(&wickens_zeta).unwrap_or_else(|| panic!("λ = {lambda}: {wickens_zeta:?}")),
+        );
+        println!(
+            "λ = {lambda}: linear critical speed full {full_vc:.2} m/s, Wickens {wickens_vc:.2} m/s"
+        );
+        assert!(
+            lambda > 0.15 || (full_vc - wickens_vc).abs() < 0.04 * wickens_vc,
+            "λ = {lambda}: critical speed {full_vc} m/s, Wickens {wickens_vc} m/s"
+        );
+        critical.push(full_vc);
+    }
+    assert!(critical[1] < 0.8 * critical[0], "{critical:?}");
 }

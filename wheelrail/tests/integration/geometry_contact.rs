@@ -194,6 +194,47 @@ fn cone_on_circular_head_gives_linear_delta_r_and_its_conicity() {
     }
 }
 
+/// The table's central conicity (the linear conicity that the conicity
+/// override of the quasi-linear analyses scales,
+/// `ContactTable::central_conicity`) of a cone on a crowned head is the
+/// rigid wheelset's analytic conicity with roll, γ/(1 − γ(R + r0)/(e + γR))
+/// (derived in `cone_on_circular_head_gives_linear_delta_r_and_its_conicity`;
+/// first order in the roll, ≈ 1e-5 rad at ±0.1 mm: tolerance 1e-3), and an
+/// error for a table without nodes beside the centre.
+#[test]
+fn table_central_conicity_of_a_cone_is_the_analytic_one() {
+    for (gamma, head) in [(0.05, 0.3), (0.15, 0.08)] {
+        let (ws, tr) = cone_on_circle(gamma, head);
+        let geo = ContactGeometry::new(&ws, &tr, SearchSettings::default()).unwrap();
+        let settings = TableSettings {
+            y_max: 0.001,
+            dy: 0.1e-3,
+            roll_max: 0.004,
+            droll: 2e-3,
+        };
+        let table = ContactTable::from_geometry(&geo, settings).unwrap();
+        let c = geo.rigid(0.0).unwrap();
+        let e = 0.5 * (c.sides[0].deepest().rail_y - c.sides[1].deepest().rail_y);
+        let expected = gamma / (1.0 - gamma * (head + 0.46) / (e + gamma * head));
+        let lambda = table.central_conicity().unwrap();
+        println!("γ {gamma}, R {head} m: table {lambda:.6}, analytic {expected:.6}");
+        assert!(
+            (lambda / expected - 1.0).abs() < 1e-3,
+            "γ {gamma}: {lambda} vs {expected}"
+        );
+        let single = ContactTable::from_geometry(
+            &geo,
+            TableSettings {
+                y_max: 0.0,
+                ..settings
+            },
+        );
+        // A zero range is refused when the table is built, or the
+        // conicity is.
+        assert!(single.is_err() || single.unwrap().central_conicity().is_err());
+    }
+}
+
 #[test]
 fn conicity_of_analytic_delta_r() {
     // Δr = 2γy on a sampled grid -> γ; independent of r0 e0 (λ² ∝ r0 e0).

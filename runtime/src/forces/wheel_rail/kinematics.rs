@@ -167,9 +167,28 @@ impl WheelRailContact {
     }
 
     /// The contact table's region contacts for a side's wheelset position
-    /// with its rail displaced laterally by `rail_dy` (m).
+    /// with its rail displaced laterally by `rail_dy` (m). With a conicity
+    /// override the table is looked up at the lateral shift y' = s y
+    /// (`shift_scale` s) and each contact's rail point is moved by y − y',
+    /// so that it lies where the profiles' contact at y' lies relative to
+    /// the wheelset (see the element's "Conicity override").
     pub(super) fn lookup(&self, s: &Side, rail_dy: f64) -> Result<[[Contact; 2]; 2], SimError> {
         let y = s.y - rail_dy;
+        let scale = s.b.shift_scale;
+        if scale != 1.0 {
+            let scaled = scale * y;
+            let mut sets = self.lookup_at(s, scaled)?;
+            for c in sets.iter_mut().flatten() {
+                c.rail_y -= scaled - y;
+            }
+            return Ok(sets);
+        }
+        self.lookup_at(s, y)
+    }
+
+    /// The contact table's region contacts at the lateral shift `y` (m) and
+    /// the side's roll.
+    fn lookup_at(&self, s: &Side, y: f64) -> Result<[[Contact; 2]; 2], SimError> {
         s.b.contact.table.lookup_regions(y, s.roll).map_err(|e| {
             self.diverged(
                 s.ctx.t,

@@ -59,6 +59,45 @@
 //! from that body's velocity and angular velocity, so each wheel rolls at its
 //! own speed and no longitudinal creep couples the two.
 //!
+//! **Conicity override** (the classical quasi-linear analysis: modes and
+//! linear critical speed as a function of the equivalent conicity λ,
+//! `umsim modes --conicity`; [`TrackBinding::conicity`]): the contact table
+//! is looked up at the lateral shift y' = s y instead of y, with
+//! s = λ / λ₀ and λ₀ the table's own central conicity
+//! ([`railmbs_wheelrail::geometry::ContactTable::central_conicity`]: ½ dΔr/dy
+//! of the exact rigid contact at the centre, over the table's nodes at
+//! ±dy, the roll following; the small-amplitude limit of EN 15302's
+//! equivalent conicity), and each contact's rail point is moved
+//! by y − y' so that it lies, relative to the wheelset, where the profiles'
+//! contact at y' lies. Every derivative of the contact geometry with
+//! respect to the shift is then the profiles' times s: the rolling radius
+//! difference's slope is 2λ, and the contact angles' slope (the
+//! gravitational stiffness, the spin's change), the roll that follows the
+//! shift and the contacts' travel across the wheel are scaled alike; the
+//! centred values (contact angle δ₀, rolling radius r₀, contact distance
+//! 2e, the Hertz ellipses and Kalker's coefficients) are the profiles'.
+//! So Wickens' contact parameters keep their real ratios to λ (ε/λ for the
+//! contact angles, σ/λ for the roll; Wickens 1965, "The dynamic stability
+//! of railway vehicle wheelsets and bogies having profiled wheels", Int.
+//! J. Solids Struct. 1). Why this and not the cone (constant contact angle,
+//! no gravitational stiffness): for circular-arc profiles (wheel radius
+//! R_w, rail R_r) a shift y turns the line of the profiles' centres by
+//! y/(R_w − R_r), so λ ≈ δ₀ R_w/(R_w − R_r) and the contact angle's slope
+//! 1/(R_w − R_r) both grow with the conformity, the way wear raises the
+//! conicity (Polach & Nicklisch, "Wheel/rail contact geometry parameters in
+//! regard to vehicle behaviour and their alteration with wear", Wear 2016);
+//! the cone drops the gravitational stiffness that, less the spin's part,
+//! sets the wheelset's critical speed (tests/tests/integration/wickens.rs:
+//! without it the critical speed is 24 % off). The simplifications: that
+//! family's roll follows the shift at ≈ tan δ₀/e rather than scaled (the
+//! roll rate adds r₀ φ̇/V, about 1.5 % of the lateral creepage); and the
+//! gap changes s times faster with the shift than the (unscaled) contact
+//! angle's tangent says, which makes the normal force non-conservative by
+//! (s − 1) N sin δ₀ per unit of tan δ₀ in the stiff vertical–lateral coupling of the contact
+//! (the fast contact modes; the quasi-static lateral stiffness is the
+//! profiles' times s, as above). For linear analyses: large shifts reach
+//! the table's edge or the flange s times sooner.
+//!
 //! The rails' reactions go to ground (the track is not a body of the model).
 //! Outputs per wheel follow the usual assessment conventions: Q the vertical
 //! wheel load and Y the lateral force of the wheel on the rail, positive

@@ -33,6 +33,10 @@ pub struct TrackBinding {
     /// same profiles and dimensions (of this run, or of every run given the
     /// same cache).
     pub tables: ContactTableCache,
+    /// The equivalent conicity override of the quasi-linear analyses (–),
+    /// or `None` for the profiles' own geometry: see
+    /// [`WheelRailContact`](super::WheelRailContact)'s "Conicity override".
+    pub conicity: Option<f64>,
 }
 
 /// Contact tables in memory by the content hash of what they are built from
@@ -113,6 +117,10 @@ pub(super) struct Bound {
     pub(super) law: Box<dyn CreepLaw + Send + Sync>,
     /// Nadal's limit of Y/Q for the flange angle and μ.
     pub(super) nadal: f64,
+    /// The factor s on the lateral shift at which the contact table is
+    /// looked up (1 without a conicity override): s = λ / λ₀, λ the
+    /// override, λ₀ the table's own central conicity.
+    pub(super) shift_scale: f64,
 }
 
 impl WheelRailContact {
@@ -134,6 +142,10 @@ impl WheelRailContact {
         let contact = self.prepare(binding)?;
         let law = self.c.creep.build().map_err(|e| self.err(e))?;
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
+        let shift_scale = match binding.conicity {
+            None => 1.0,
+            Some(lambda) => self.shift_scale(&contact, lambda)?,
+        };
         Ok(Bound {
             track: binding.track.clone(),
             speed: binding.speed.clone(),
@@ -141,7 +153,33 @@ impl WheelRailContact {
             contact,
             law,
             nadal,
+            shift_scale,
         })
+    }
+
+    /// The factor s = λ / λ₀ on the lateral shift of the conicity override
+    /// `lambda` (–), λ₀ the profiles' central conicity
+    /// ([`ContactTable::central_conicity`]: the exact rigid contact's
+    /// ½ dΔr/dy over the table's nodes at ±dy).
+    fn shift_scale(&self, contact: &PreparedContact, lambda: f64) -> Result<f64, SimError> {
+        if !(lambda.is_finite() && lambda > 0.0) {
+            return Err(self.err(format!(
+                "the equivalent conicity override must be positive and finite, got {lambda}"
+            )));
+        }
+        let own = contact.table.central_conicity().map_err(|e| {
+            self.err(format!(
+                "conicity override: the profiles' own central conicity: {e}"
+            ))
+        })?;
+        if !(own.is_finite() && own > 1e-6) {
+            return Err(self.err(format!(
+                "conicity override: the profiles' own central conicity is {own}, not positive: \
+                 their rolling radius difference does not restore the wheelset, and cannot be \
+                 scaled to {lambda}"
+            )));
+        }
+        Ok(lambda / own)
     }
 
     /// Places the profiles (read and validated when the model was loaded) on
