@@ -350,13 +350,13 @@ impl BlockMatrix {
         m
     }
 
-    /// Every stored entry (for finiteness checks), block by block, then the
-    /// coupling entries.
-    pub fn values(&self) -> impl Iterator<Item = f64> + '_ {
+    /// The stored entries as slices (for finiteness checks): each diagonal
+    /// block's, then the coupling entries'.
+    pub fn slices(&self) -> impl Iterator<Item = &[f64]> + '_ {
         self.diag
             .iter()
-            .flat_map(|d| d.as_slice().iter().copied())
-            .chain(self.coupling.as_slice().iter().copied())
+            .map(|d| d.as_slice())
+            .chain(std::iter::once(self.coupling.as_slice()))
     }
 
     /// Sets `self = a − β d − β² c` entry by entry (all three of the same

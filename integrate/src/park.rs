@@ -342,7 +342,7 @@ impl BlockWork {
 /// Fails with [`SimError::NonFinite`] naming the time, the quantity and the
 /// first offending entry (i, j) when `m` holds a NaN or an infinity.
 fn check_finite_blocks(t: f64, what: &str, m: &BlockMatrix) -> Result<(), SimError> {
-    if m.values().all(f64::is_finite) {
+    if m.slices().all(crate::all_finite) {
         return Ok(());
     }
     let n = m.pattern().dim();
