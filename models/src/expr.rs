@@ -362,7 +362,12 @@ impl Expr {
             },
             Expr::Neg(a) => {
                 out.push('-');
-                a.write_operand(names, 4, out);
+                // A sign binds looser than a power (-a^b is -(a^b)) but a
+                // sign after a sign needs no parentheses: --a reads back as
+                // it was written, without doubling its nesting depth (which
+                // the parser bounds).
+                let min_prec = if matches!(**a, Expr::Neg(_)) { 3 } else { 4 };
+                a.write_operand(names, min_prec, out);
             }
             Expr::Add(a, b) | Expr::Sub(a, b) => {
                 a.write_operand(names, 1, out);

@@ -222,6 +222,22 @@ fn display_round_trips() {
     assert_eq!(back.eval(&P, 0.0), e.eval(&P, 0.0));
 }
 
+/// A run of signs is displayed as a run of signs, not as nested
+/// parentheses `-(-(…))` of twice the nesting depth, which the parser's
+/// depth bound (200) refused: found by the `expr` fuzz target (fuzz/,
+/// 113 signs in "1e-8-8*1e1-1e8-8*1e-8---…---8*1e1-1e8-8").
+#[test]
+fn a_long_run_of_signs_displays_within_the_parsers_depth_bound() {
+    let n = names();
+    for signs in [2, 3, 113, 190] {
+        let text = format!("a - {}b*2", "-".repeat(signs));
+        let e = parse_expr(&text, &n, true).unwrap_or_else(|err| panic!("{text}: {err}"));
+        let shown = e.display(&n);
+        let back = parse_expr(&shown, &n, true).unwrap_or_else(|err| panic!("{shown}: {err}"));
+        assert_eq!(back, e, "{text} displayed as {shown}");
+    }
+}
+
 #[test]
 fn deep_nesting_is_an_error_not_a_crash() {
     let deep = format!("{}1{}", "(".repeat(100_000), ")".repeat(100_000));
