@@ -360,6 +360,106 @@ fn check_finite_blocks(t: f64, what: &str, m: &BlockMatrix) -> Result<(), SimErr
     Ok(())
 }
 
+/// The state and buffers of a finite-difference Jacobian at (t, q, v):
+/// f0 = f(t, q, v) evaluated, `x_pert`, `f_pert`, `f_pert2` scratch.
+struct Differences<'a> {
+    /// Central differences (steps ε^{1/3}) or forward ones (ε^{1/2}).
+    central: bool,
+    t: f64,
+    q: &'a DVector<f64>,
+    v: &'a DVector<f64>,
+    f0: &'a DVector<f64>,
+    x_pert: &'a mut DVector<f64>,
+    f_pert: &'a mut DVector<f64>,
+    f_pert2: &'a mut DVector<f64>,
+    /// The steps of a group's columns up and down (reused storage).
+    steps: &'a mut (Vec<f64>, Vec<f64>),
+}
+
+/// `eval(q, q̇, f)` of [`difference_columns`]: f at a perturbed state.
+type EvaluateForce<'a> = dyn FnMut(&[f64], &[f64], &mut DVector<f64>) -> Result<(), SimError> + 'a;
+
+/// `store(wrt_v, j, step, f_high, f_low)` of [`difference_columns`].
+type StoreColumn<'a> = dyn FnMut(bool, usize, f64, &DVector<f64>, &DVector<f64>) + 'a;
+
+/// The finite-difference columns of ∂f/∂q, then ∂f/∂q̇: the coordinates
+/// of each group of `groups` (columns that touch disjoint rows) perturbed
+/// together by rel·max(|x|, 1), f evaluated by `eval(q, q̇, f)`; for each
+/// column j `store(wrt_v, j, step, f_high, f_low)` with the exactly
+/// representable step (the sum of both for central differences), the one
+/// difference loop of the dense and the block paths.
+fn difference_columns(
+    d: Differences<'_>,
+    groups: &[Vec<usize>],
+    st: &mut IntegrationStats,
+    eval: &mut EvaluateForce<'_>,
+    store: &mut StoreColumn<'_>,
+) -> Result<(), SimError> {
+    let Differences {
+        central,
+        t,
+        q,
+        v,
+        f0,
+        x_pert,
+        f_pert,
+        f_pert2,
+        steps,
+    } = d;
+    let rel = if central {
+        f64::EPSILON.cbrt()
+    } else {
+        f64::EPSILON.sqrt()
+    };
+    let (steps_p, steps_m) = (&mut steps.0, &mut steps.1);
+    // Columns with respect to q (wrt_v = false) and q̇ (wrt_v = true).
+    for wrt_v in [false, true] {
+        let base = if wrt_v { v } else { q };
+        x_pert.copy_from(base);
+        for group in groups {
+            steps_p.clear();
+            for &j in group {
+                let xj = x_pert[j];
+                x_pert[j] = xj + rel * xj.abs().max(1.0);
+                steps_p.push(x_pert[j] - xj); // exactly representable increment
+            }
+            st.dynamics_evaluations += 1;
+            if wrt_v {
+                eval(q.as_slice(), x_pert.as_slice(), f_pert)?;
+            } else {
+                eval(x_pert.as_slice(), v.as_slice(), f_pert)?;
+            }
+            check_finite(t, "force f (Jacobian difference)", f_pert.as_slice())?;
+            if central {
+                steps_m.clear();
+                for &j in group {
+                    let xj = base[j];
+                    x_pert[j] = xj - rel * xj.abs().max(1.0);
+                    steps_m.push(xj - x_pert[j]);
+                }
+                st.dynamics_evaluations += 1;
+                if wrt_v {
+                    eval(q.as_slice(), x_pert.as_slice(), f_pert2)?;
+                } else {
+                    eval(x_pert.as_slice(), v.as_slice(), f_pert2)?;
+                }
+                check_finite(t, "force f (Jacobian difference)", f_pert2.as_slice())?;
+                for ((&j, dp), dm) in group.iter().zip(steps_p.iter()).zip(steps_m.iter()) {
+                    store(wrt_v, j, dp + dm, f_pert, f_pert2);
+                }
+            } else {
+                for (&j, dp) in group.iter().zip(steps_p.iter()) {
+                    store(wrt_v, j, *dp, f_pert, f0);
+                }
+            }
+            for &j in group {
+                x_pert[j] = base[j];
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Workspaces sized for one system (n coordinates, nc constraints).
 #[derive(Debug)]
 struct Work {
@@ -380,6 +480,11 @@ struct Work {
     f_pert2: DVector<f64>,
     mass_pert: DMatrix<f64>,
     x_pert: DVector<f64>,
+    /// The finite-difference column groups of the dense path: every
+    /// coordinate alone (the block path's are [`BlockWork::groups`]).
+    dense_groups: Vec<Vec<usize>>,
+    /// The steps of a group's columns in [`difference_columns`].
+    difference_steps: (Vec<f64>, Vec<f64>),
     analytic_ok: bool,
     /// Coordinates that appear in the constraints (a nonzero column of G at
     /// any Jacobian evaluation so far): their velocities are index-2
@@ -447,6 +552,8 @@ impl Work {
             f_pert2: v(),
             mass_pert: sq(),
             x_pert: v(),
+            dense_groups: (0..nd).map(|j| vec![j]).collect(),
+            difference_steps: (Vec::with_capacity(n), Vec::with_capacity(n)),
             analytic_ok: true,
             constrained: vec![false; n],
             lu: DenseLu::new(nd + nc),
@@ -734,69 +841,29 @@ impl Work {
             }
             self.analytic_ok = false;
         }
-        let central = kind == JacobianKind::CentralDifference;
-        let rel = if central {
-            f64::EPSILON.cbrt()
-        } else {
-            f64::EPSILON.sqrt()
-        };
-        // Columns with respect to q (wrt = false) and q̇ (wrt = true).
-        for wrt_v in [false, true] {
-            let base = if wrt_v { &self.v } else { &self.q };
-            self.x_pert.copy_from(base);
-            for j in 0..n {
-                let xj = self.x_pert[j];
-                let step = rel * xj.abs().max(1.0);
-                self.x_pert[j] = xj + step;
-                let dp = self.x_pert[j] - xj; // exactly representable increment
-                let (qs, vs) = if wrt_v {
-                    (&self.q, &self.x_pert)
-                } else {
-                    (&self.x_pert, &self.v)
-                };
-                st.dynamics_evaluations += 1;
-                system.dynamics(
-                    t,
-                    qs.as_slice(),
-                    vs.as_slice(),
-                    &mut self.mass_pert,
-                    &mut self.f_pert,
-                )?;
-                check_finite(t, "force f (Jacobian difference)", self.f_pert.as_slice())?;
-                let out = if wrt_v {
-                    &mut self.dfdv
-                } else {
-                    &mut self.dfdq
-                };
-                if central {
-                    self.x_pert[j] = xj - step;
-                    let dm = xj - self.x_pert[j];
-                    let (qs, vs) = if wrt_v {
-                        (&self.q, &self.x_pert)
-                    } else {
-                        (&self.x_pert, &self.v)
-                    };
-                    st.dynamics_evaluations += 1;
-                    system.dynamics(
-                        t,
-                        qs.as_slice(),
-                        vs.as_slice(),
-                        &mut self.mass_pert,
-                        &mut self.f_pert2,
-                    )?;
-                    check_finite(t, "force f (Jacobian difference)", self.f_pert2.as_slice())?;
-                    for i in 0..n {
-                        out[(i, j)] = (self.f_pert[i] - self.f_pert2[i]) / (dp + dm);
-                    }
-                } else {
-                    for i in 0..n {
-                        out[(i, j)] = (self.f_pert[i] - self.f0[i]) / dp;
-                    }
+        let (dfdq, dfdv, mass_pert) = (&mut self.dfdq, &mut self.dfdv, &mut self.mass_pert);
+        difference_columns(
+            Differences {
+                central: kind == JacobianKind::CentralDifference,
+                t,
+                q: &self.q,
+                v: &self.v,
+                f0: &self.f0,
+                x_pert: &mut self.x_pert,
+                f_pert: &mut self.f_pert,
+                f_pert2: &mut self.f_pert2,
+                steps: &mut self.difference_steps,
+            },
+            &self.dense_groups,
+            st,
+            &mut |q, v, f| system.dynamics(t, q, v, mass_pert, f),
+            &mut |wrt_v, j, step, high, low| {
+                let out = if wrt_v { &mut *dfdv } else { &mut *dfdq };
+                for i in 0..n {
+                    out[(i, j)] = (high[i] - low[i]) / step;
                 }
-                self.x_pert[j] = xj;
-            }
-        }
-        Ok(())
+            },
+        )
     }
 
     /// [`Work::evaluate_jacobian`] into the block matrices: the same
@@ -835,82 +902,36 @@ impl Work {
             }
             self.analytic_ok = false;
         }
-        let central = kind == JacobianKind::CentralDifference;
-        let rel = if central {
-            f64::EPSILON.cbrt()
-        } else {
-            f64::EPSILON.sqrt()
-        };
         b.dfdq.fill_zero();
         b.dfdv.fill_zero();
         // Columns by groups of the pattern (coordinates whose columns touch
         // disjoint rows, perturbed together): a train's vehicles are
-        // differentiated at once, the border coordinates one by one.
-        let (mut steps_p, mut steps_m) = (Vec::new(), Vec::new());
-        for wrt_v in [false, true] {
-            let base = if wrt_v { &self.v } else { &self.q };
-            self.x_pert.copy_from(base);
-            for group in &b.groups {
-                steps_p.clear();
-                for &j in group {
-                    let xj = self.x_pert[j];
-                    self.x_pert[j] = xj + rel * xj.abs().max(1.0);
-                    steps_p.push(self.x_pert[j] - xj); // exactly representable increment
+        // differentiated at once, the border coordinates one by one; only
+        // the entries the pattern holds are stored.
+        let (dfdq, dfdv, mass_pert, pattern) =
+            (&mut b.dfdq, &mut b.dfdv, &mut b.mass_pert, &b.pattern);
+        difference_columns(
+            Differences {
+                central: kind == JacobianKind::CentralDifference,
+                t,
+                q: &self.q,
+                v: &self.v,
+                f0: &self.f0,
+                x_pert: &mut self.x_pert,
+                f_pert: &mut self.f_pert,
+                f_pert2: &mut self.f_pert2,
+                steps: &mut self.difference_steps,
+            },
+            &b.groups,
+            st,
+            &mut |q, v, f| system.dynamics_blocks(t, q, v, mass_pert, f),
+            &mut |wrt_v, j, step, high, low| {
+                let out = if wrt_v { &mut *dfdv } else { &mut *dfdq };
+                for i in pattern.column_rows(j) {
+                    out.add(i, j, (high[i] - low[i]) / step);
                 }
-                let (qs, vs) = if wrt_v {
-                    (&self.q, &self.x_pert)
-                } else {
-                    (&self.x_pert, &self.v)
-                };
-                st.dynamics_evaluations += 1;
-                system.dynamics_blocks(
-                    t,
-                    qs.as_slice(),
-                    vs.as_slice(),
-                    &mut b.mass_pert,
-                    &mut self.f_pert,
-                )?;
-                check_finite(t, "force f (Jacobian difference)", self.f_pert.as_slice())?;
-                let out = if wrt_v { &mut b.dfdv } else { &mut b.dfdq };
-                if central {
-                    steps_m.clear();
-                    for &j in group {
-                        let xj = base[j];
-                        self.x_pert[j] = xj - rel * xj.abs().max(1.0);
-                        steps_m.push(xj - self.x_pert[j]);
-                    }
-                    let (qs, vs) = if wrt_v {
-                        (&self.q, &self.x_pert)
-                    } else {
-                        (&self.x_pert, &self.v)
-                    };
-                    st.dynamics_evaluations += 1;
-                    system.dynamics_blocks(
-                        t,
-                        qs.as_slice(),
-                        vs.as_slice(),
-                        &mut b.mass_pert,
-                        &mut self.f_pert2,
-                    )?;
-                    check_finite(t, "force f (Jacobian difference)", self.f_pert2.as_slice())?;
-                    for ((&j, dp), dm) in group.iter().zip(&steps_p).zip(&steps_m) {
-                        for i in b.pattern.column_rows(j) {
-                            out.add(i, j, (self.f_pert[i] - self.f_pert2[i]) / (dp + dm));
-                        }
-                    }
-                } else {
-                    for (&j, dp) in group.iter().zip(&steps_p) {
-                        for i in b.pattern.column_rows(j) {
-                            out.add(i, j, (self.f_pert[i] - self.f0[i]) / dp);
-                        }
-                    }
-                }
-                for &j in group {
-                    self.x_pert[j] = base[j];
-                }
-            }
-        }
-        Ok(())
+            },
+        )
     }
 
     /// Forms and factorizes the iteration matrix for `beta`. Returns `false`

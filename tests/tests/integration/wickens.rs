@@ -351,6 +351,24 @@ fn wheelset_on_springs_hunts_as_wickens_linear_wheelset() {
     );
 }
 
+/// The wheelset of `wheelset_on_springs_critical.ron` with Kalker's linear
+/// law, its lateral and yaw suspension removed (ky = cy = cx = 0) and held
+/// longitudinally by a 1 kN/m spring per axlebox, centred (see
+/// [`a_free_wheelset_oscillates_at_klingels_kinematic_frequency`]).
+fn free_wheelset() -> (Scenario, Model) {
+    let (mut s, model) = soft_wheelset(Some(CreepLawSpec::Kalker));
+    for (name, value) in [
+        ("kx", "1e3"),
+        ("ky", "0"),
+        ("cx", "0"),
+        ("cy", "0"),
+        ("y0", "0"),
+    ] {
+        s.set_parameter(name, value);
+    }
+    (s, model)
+}
+
 /// The free wheelset's kinematic oscillation: Klingel's frequency
 /// f = V/(2π) √(λ/(r0 e)) (Klingel 1883)
 /// is the limit of the hunting mode's frequency as V → 0, where the creep
@@ -376,16 +394,7 @@ fn wheelset_on_springs_hunts_as_wickens_linear_wheelset() {
 /// 0.02 % of Klingel at these speeds.
 #[test]
 fn a_free_wheelset_oscillates_at_klingels_kinematic_frequency() {
-    let (mut s, model) = soft_wheelset(Some(CreepLawSpec::Kalker));
-    for (name, value) in [
-        ("kx", "1e3"),
-        ("ky", "0"),
-        ("cx", "0"),
-        ("cy", "0"),
-        ("y0", "0"),
-    ] {
-        s.set_parameter(name, value);
-    }
+    let (s, model) = free_wheelset();
     let susp = suspension(&model, &s);
     let w = wheelset_contact(susp.q, 1e-4);
     for v in [1.0, 2.0, 5.0, 10.0] {
@@ -428,16 +437,7 @@ fn a_free_wheelset_oscillates_at_klingels_kinematic_frequency() {
 /// sees the same offset once the roll is counted). Tolerance 0.6 %.
 #[test]
 fn a_free_wheelset_at_an_overridden_conicity_oscillates_at_klingels_frequency() {
-    let (mut s, model) = soft_wheelset(Some(CreepLawSpec::Kalker));
-    for (name, value) in [
-        ("kx", "1e3"),
-        ("ky", "0"),
-        ("cx", "0"),
-        ("cy", "0"),
-        ("y0", "0"),
-    ] {
-        s.set_parameter(name, value);
-    }
+    let (s, model) = free_wheelset();
     let susp = suspension(&model, &s);
     let w = wheelset_contact(susp.q, 1e-4);
     println!(
