@@ -1,6 +1,6 @@
 //! `umsim critical-speed SCENARIO [--bifurcation FROM:TO:STEP] [--signal
 //! COORD]… [--window S] [--threshold M] [--track FILE] [-o CSV] [--plot
-//! FILE.svg|png] [--engine …] [--set NAME=VALUE]…`: the nonlinear critical
+//! FILE.svg|png] [--end-time S] [--engine …] [--set NAME=VALUE]…`: the nonlinear critical
 //! speed (`railmbs_runtime::analysis::critical`).
 //!
 //! Without `--bifurcation`, the scenario is a decelerating run (its
@@ -63,6 +63,11 @@ pub struct Args {
     /// [default: half a plateau].
     #[arg(long)]
     pub measure: Option<f64>,
+    /// Runs the decelerating run to this end time instead of the
+    /// scenario's, s (for a scenario bundled short, as the freight car's
+    /// hunting run; ignored with `--bifurcation`, whose plan sets the end).
+    #[arg(long, value_name = "SECONDS")]
+    pub end_time: Option<f64>,
     /// Runs on this track file instead of the scenario's (a longer straight
     /// track for a long continuation).
     #[arg(long, value_name = "FILE")]
@@ -82,6 +87,11 @@ pub struct Args {
 /// Runs `umsim critical-speed`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let (mut scenario, model) = args.engine.load(&args.scenario)?;
+    if let Some(t) = args.end_time {
+        scenario
+            .set_end_time(t)
+            .map_err(|e| format!("{}: --end-time: {e}", args.scenario.display()))?;
+    }
     if let Some(file) = &args.track {
         let Some(track) = &mut scenario.track else {
             return Err(format!(
