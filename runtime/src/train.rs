@@ -462,13 +462,7 @@ impl TrainSystem {
         out: &mut Vec<f64>,
     ) -> Result<(), SimError> {
         for ci in 0..self.couplers.len() {
-            let mut bodies = vec![BodyKinematics::default(); self.couplers[ci].bodies.len()];
-            for (i, body) in bodies.iter_mut().enumerate() {
-                let (k, b) = self.couplers[ci].bodies[i];
-                let r = self.ranges[k].clone();
-                let e = self.vehicles[k].evaluate(t, &q[r.clone()], &v[r], Parts::KINEMATICS)?;
-                *body = e.bodies[b];
-            }
+            let bodies = self.coupler_bodies_at(ci, t, q, v)?;
             let ctx = ForceContext {
                 t,
                 bodies: &bodies,
@@ -479,6 +473,54 @@ impl TrainSystem {
             self.couplers[ci].element.outputs(&ctx, out);
         }
         Ok(())
+    }
+
+    /// The wrenches of every coupler on its bodies at a state (evaluates
+    /// the coupled vehicles' kinematics), in coupler order: per body its
+    /// kinematics and the wrench on it (force, N, and moment about its
+    /// centre of mass, N m, both in SC0). The forces a run applies, for
+    /// checks such as Newton's third law across a coupler.
+    #[allow(clippy::type_complexity)]
+    pub fn coupler_wrenches(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<Vec<(BodyKinematics, Wrench)>>, SimError> {
+        let mut all = Vec::with_capacity(self.couplers.len());
+        for ci in 0..self.couplers.len() {
+            let bodies = self.coupler_bodies_at(ci, t, q, v)?;
+            let ctx = ForceContext {
+                t,
+                bodies: &bodies,
+                params: &[],
+                states: &[],
+                state_rates: &[],
+            };
+            let mut w = vec![Wrench::default(); bodies.len()];
+            self.couplers[ci].element.apply(&ctx, &mut w)?;
+            all.push(bodies.into_iter().zip(w).collect());
+        }
+        Ok(all)
+    }
+
+    /// Kinematics of the bodies of coupler `ci` at a state (evaluates their
+    /// vehicles).
+    fn coupler_bodies_at(
+        &mut self,
+        ci: usize,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<BodyKinematics>, SimError> {
+        let mut bodies = vec![BodyKinematics::default(); self.couplers[ci].bodies.len()];
+        for (i, body) in bodies.iter_mut().enumerate() {
+            let (k, b) = self.couplers[ci].bodies[i];
+            let r = self.ranges[k].clone();
+            let e = self.vehicles[k].evaluate(t, &q[r.clone()], &v[r], Parts::KINEMATICS)?;
+            *body = e.bodies[b];
+        }
+        Ok(bodies)
     }
 }
 

@@ -7,6 +7,7 @@ mod dynamics;
 mod equations;
 mod equilibrium;
 mod freight;
+mod freight_train;
 mod modes;
 mod plugins;
 mod symbolic;

@@ -29,7 +29,7 @@ fn run(train: &TrainScenario, out: &Path) -> Table {
 
 /// The text of the bundled train file `name` with absolute paths, written
 /// to `dir/<file>` and read there.
-fn bundled_text(name: &str) -> String {
+pub(crate) fn bundled_text(name: &str) -> String {
     std::fs::read_to_string(model_path(&format!("scenarios/{name}")))
         .unwrap()
         .replace(
@@ -43,7 +43,7 @@ fn bundled_text(name: &str) -> String {
 }
 
 /// `text` written to `dir/file` and read as a train.
-fn train_at(dir: &Path, file: &str, text: &str) -> TrainScenario {
+pub(crate) fn train_at(dir: &Path, file: &str, text: &str) -> TrainScenario {
     let path = dir.join(file);
     std::fs::write(&path, text).unwrap();
     parse_train(text, &path).unwrap_or_else(|e| panic!("{e}"))
