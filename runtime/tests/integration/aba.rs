@@ -20,6 +20,9 @@ const FORCES: Parts = Parts {
     constraints: false,
 };
 
+/// M⁻¹ (Q_g − k) and M⁻¹ b.
+type Pair = (DVector<f64>, DVector<f64>);
+
 fn aba_engine(model: &Model) -> NumericEquations {
     let mut e = NumericEquations::with_formalism(model, Formalism::ArticulatedBody)
         .unwrap_or_else(|e| panic!("{e}"));
@@ -36,7 +39,7 @@ fn both(
     q: &[f64],
     v: &[f64],
     b: &[f64],
-) -> ((DVector<f64>, DVector<f64>), (DVector<f64>, DVector<f64>)) {
+) -> (Pair, Pair) {
     let mut crb = numeric_engine(model);
     let mut aba = aba_engine(model);
     let mut e = Evaluation::for_equations(&crb);
@@ -74,7 +77,7 @@ fn rel(a: &DVector<f64>, reference: &DVector<f64>) -> f64 {
 /// random states: κ ≈ 3e6) 1e-12 is not a property of any solver.
 #[test]
 fn aba_matches_composite_body_and_cholesky_at_random_states() {
-    let mut rng = seeded_rng(19_3);
+    let mut rng = seeded_rng(193);
     let mut models: Vec<Model> = all_mechanisms();
     models.extend(all_vehicles());
     models.push(chain(30, true));
