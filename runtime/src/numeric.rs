@@ -194,7 +194,7 @@ pub struct NumericEquations {
     /// Articulated-body work buffers: per body the articulated inertia (6×6,
     /// spatial, about the tree's root point, SC0 axes) and bias force it
     /// passes to its parent, and its spatial acceleration; per coordinate
-    /// U = I^A s, D = sᵀ U and u = τ − sᵀ p^A (Featherstone 2008, Table 7.1).
+    /// U = I^A s, D = sᵀ U and u = τ − sᵀ p^A (Featherstone 2008, Sect. 7.3).
     art_inertia: Vec<Matrix6<f64>>,
     art_bias: Vec<Vector6<f64>>,
     art_acc: Vec<Vector6<f64>>,
@@ -541,7 +541,8 @@ impl NumericEquations {
 
     /// Spatial inertia of body `j` about its tree's root point o in SC0 axes
     /// (motion vectors (ω, v_o), force vectors (n_o, f)): with d = c − o,
-    /// `[[I_c + m d̃ d̃ᵀ, m d̃], [m d̃ᵀ, m E]]` (Featherstone 2008, Eq. 2.63).
+    /// `[[I_c + m d̃ d̃ᵀ, m d̃], [m d̃ᵀ, m E]]` (Featherstone 2008, ch. 2: the rigid-body inertia
+    /// about a point other than the centre of mass).
     fn spatial_inertia(&self, j: usize) -> Matrix6<f64> {
         let m = self.bodies[j].mass;
         let d = self.states[j].r - self.states[self.bodies[j].root].r;
@@ -560,7 +561,7 @@ impl NumericEquations {
 
     /// Solves M x = b in place (b: generalized forces, N or N m; x: q̈, m/s²
     /// or rad/s²) by the articulated-body recursion (Featherstone 2008,
-    /// Table 7.1, passes 2 and 3 with zero velocity terms, in absolute
+    /// Sect. 7.3, passes 2 and 3 with zero velocity terms, in absolute
     /// coordinates), O(n), at the kinematics of the last forward pass.
     ///
     /// Backward, per body (children first), then per own coordinate from the

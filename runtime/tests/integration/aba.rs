@@ -34,12 +34,7 @@ fn aba_engine(model: &Model) -> NumericEquations {
 /// q̈ = M⁻¹ (Q_g − k) by the composite-body M and nalgebra's Cholesky, and
 /// by the articulated-body solve, at (q, q̇); and the same for the extra
 /// right-hand side `b` (M⁻¹ b, velocity terms not involved).
-fn both(
-    model: &Model,
-    q: &[f64],
-    v: &[f64],
-    b: &[f64],
-) -> (Pair, Pair) {
+fn both(model: &Model, q: &[f64], v: &[f64], b: &[f64]) -> (Pair, Pair) {
     let mut crb = numeric_engine(model);
     let mut aba = aba_engine(model);
     let mut e = Evaluation::for_equations(&crb);
