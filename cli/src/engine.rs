@@ -2,7 +2,7 @@
 
 use railmbs_codegen::{GenerateOptions, PluginFile};
 use railmbs_models::Model;
-use railmbs_runtime::{Equations, NumericEquations, Plugin, PluginEquations};
+use railmbs_runtime::{Equations, Formalism, NumericEquations, Plugin, PluginEquations};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +13,27 @@ pub enum Engine {
     Numeric,
     /// A compiled symbolic plugin (built through the cache when none is given).
     Symbolic,
+    /// The numeric engine with the articulated-body formalism: q̈ in O(n)
+    /// without the mass matrix, for open trees (no cut joints) integrated
+    /// with RK4. Park's method and the analyses need M and its Jacobians:
+    /// they refuse this engine (use `numeric`, the composite-body M).
+    NumericAba,
+}
+
+impl Engine {
+    /// Refuses [`Engine::NumericAba`] for `what` (a command or integrator
+    /// that needs the mass matrix), saying why and what to use instead.
+    pub fn require_mass_matrix(self, what: &str) -> Result<(), String> {
+        if self == Engine::NumericAba {
+            Err(format!(
+                "--engine numeric-aba: {what} needs the mass matrix M (and its Jacobians), \
+                 which the articulated-body method does not form; it serves explicit \
+                 integration (RK4) only. Use --engine numeric (composite-body M)"
+            ))
+        } else {
+            Ok(())
+        }
+    }
 }
 
 /// Generates and compiles (through the plugin cache) the plugin of `model`, for this
@@ -69,6 +90,10 @@ pub fn build_engine_with(
 ) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
     match engine {
         Engine::Numeric => Ok(Box::new(NumericEquations::new(model))),
+        Engine::NumericAba => Ok(Box::new(NumericEquations::with_formalism(
+            model,
+            Formalism::ArticulatedBody,
+        )?)),
         Engine::Symbolic => {
             let path = match plugin {
                 Some(p) => p.to_path_buf(),
@@ -118,6 +143,7 @@ impl EngineOptions {
         } else {
             self.engine
         };
+        engine.require_mass_matrix("this analysis")?;
         build_engine(model, engine, self.plugin.as_deref())
     }
 }

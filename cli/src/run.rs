@@ -124,6 +124,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         args.engine
     };
+    if matches!(
+        scenario.integrator,
+        railmbs_models::IntegratorSpec::Park { .. }
+    ) {
+        engine.require_mass_matrix("Park's implicit method (the scenario's integrator)")?;
+    }
     let equations = build_engine(&model, engine, args.plugin.as_deref())?;
     let output = args.output.clone().or_else(|| scenario.output_file.clone());
 
@@ -235,7 +241,7 @@ impl TrainEngines {
                         model.set_creep_law(law);
                     }
                     let plugin = match (engine, plugin) {
-                        (Engine::Numeric, _) => None,
+                        (Engine::Numeric | Engine::NumericAba, _) => None,
                         (Engine::Symbolic, Some(p)) => Some(p.to_path_buf()),
                         (Engine::Symbolic, None) => {
                             Some(crate::engine::build_symbolic(&model, false)?.path)
@@ -278,6 +284,7 @@ fn run_train(
     } else {
         args.engine
     };
+    engine.require_mass_matrix("a train (its system solves the coupled vehicles' M)")?;
     let TrainEngines {
         models,
         vehicle_models,

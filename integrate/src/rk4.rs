@@ -46,6 +46,11 @@ fn acceleration<S: MechanicalSystem + ?Sized>(
     stats: &mut IntegrationStats,
 ) -> Result<(), SimError> {
     stats.dynamics_evaluations += 1;
+    // A system with an O(n) solve (the articulated-body method) gives q̈
+    // directly; M is then neither formed nor factored.
+    if system.accelerations(t, q.as_slice(), v.as_slice(), accel)? {
+        return check_finite(t, "acceleration q̈", accel.as_slice());
+    }
     system.dynamics(t, q.as_slice(), v.as_slice(), mass, accel)?;
     // The factorization fails on a NaN, and a NaN in f reaches q̈: M and f are
     // searched for the culprit only then, so the common path pays nothing.

@@ -76,6 +76,21 @@ pub trait MechanicalSystem {
         force: &mut DVector<f64>,
     ) -> Result<(), SimError>;
 
+    /// q̈ = M⁻¹ f into `accel` (n) without forming and factoring M, for
+    /// systems whose equations have such a solve (the articulated-body
+    /// method, O(n)). Returns `Ok(false)`, `accel` unspecified, when the
+    /// system has none: explicit integrators then call
+    /// [`MechanicalSystem::dynamics`] and factor M. Implicit methods (Park's)
+    /// need M and its Jacobians and never call this.
+    fn accelerations(
+        &mut self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        _accel: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        Ok(false)
+    }
     /// Constraint residual g (nc) and its Jacobian G = ∂g/∂q (nc×n). Called only
     /// when `n_constraints() > 0`.
     fn constraints(
@@ -213,6 +228,15 @@ impl<S: MechanicalSystem + ?Sized> MechanicalSystem for &mut S {
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
         (**self).dynamics(t, q, v, mass, force)
+    }
+    fn accelerations(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        accel: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        (**self).accelerations(t, q, v, accel)
     }
 
     fn constraints(

@@ -55,6 +55,9 @@ impl<'a> Engines<'a> {
     ) -> Result<Self, String> {
         match engine {
             Engine::Numeric => Ok(Self::Numeric(model)),
+            Engine::NumericAba => Err(Engine::NumericAba
+                .require_mass_matrix("this analysis")
+                .expect_err("numeric-aba needs no M")),
             Engine::Symbolic => {
                 let path = match plugin {
                     Some(p) => p.to_path_buf(),

@@ -182,6 +182,20 @@ pub trait Equations: Send {
             )))
         }
     }
+    /// Whether [`Equations::solve_mass`] solves (an O(n) method without M,
+    /// the articulated-body formalism of the numeric engine). `false` by
+    /// default: callers factor M themselves.
+    fn solves_mass(&self) -> bool {
+        false
+    }
+    /// Solves M x = b in place (b generalized forces in, x accelerations
+    /// out) at the state of the last [`Equations::evaluate`] that computed
+    /// the bias terms or M, without forming M. `Ok(false)` with `b`
+    /// untouched when the engine has no such method
+    /// ([`Equations::solves_mass`]).
+    fn solve_mass(&mut self, _b: &mut [f64]) -> Result<bool, SimError> {
+        Ok(false)
+    }
     /// Evaluates the requested parts at (t, q, q̇) into `out`.
     fn evaluate(
         &mut self,

@@ -89,6 +89,12 @@ impl Equations for DrivenEquations {
     fn set_parameters(&mut self, params: &[f64]) -> Result<(), SimError> {
         self.inner.set_parameters(params)
     }
+    fn solves_mass(&self) -> bool {
+        self.inner.solves_mass()
+    }
+    fn solve_mass(&mut self, b: &mut [f64]) -> Result<bool, SimError> {
+        self.inner.solve_mass(b)
+    }
     fn evaluate(
         &mut self,
         t: f64,

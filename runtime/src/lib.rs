@@ -33,7 +33,7 @@ pub mod train;
 pub use equations::{BodyKinematics, Equations, Evaluation, Parts};
 pub use inputs::{DrivenEquations, InputProvider};
 pub use model_system::ModelSystem;
-pub use numeric::NumericEquations;
+pub use numeric::{Formalism, NumericEquations};
 pub use plugin::{Plugin, PluginEquations, PluginError};
 pub use railmbs_integrate as integrate;
 pub use railmbs_integrate::system;

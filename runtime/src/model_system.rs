@@ -376,6 +376,33 @@ impl MechanicalSystem for ModelSystem {
         Ok(())
     }
 
+    /// With equations that solve M x = b themselves (the articulated-body
+    /// formalism, [`crate::Equations::solves_mass`]) and no element states:
+    /// M is not evaluated, q̈ = M⁻¹ (Q − k) by that solve in O(n).
+    fn accelerations(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        accel: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        if !self.states.is_empty() || self.n_constraints() > 0 || !self.equations.solves_mass() {
+            return Ok(false);
+        }
+        if !self.forces_initialized {
+            self.accept_forces(t, q, v)?;
+        }
+        let (q, v) = self.take_states(q, v);
+        let parts = Parts {
+            mass: false,
+            ..self.dynamics_parts
+        };
+        self.equations.evaluate(t, q, v, parts, &mut self.eval)?;
+        self.applied_forces(t, accel)?;
+        *accel -= &self.eval.bias;
+        self.equations.solve_mass(accel.as_mut_slice())
+    }
+
     fn constraints(
         &mut self,
         t: f64,

@@ -30,10 +30,26 @@
 //! never allocates. M_ik is the scalar product of coordinate k's motion vector
 //! (u_k, (p_k − o) × u_k) with the spatial momentum of body i's composite
 //! subtree about the tree's root point o (two 3-vector dot products per entry).
+//!
+//! Formalisms ([`Formalism`]; Pogorelov 2005, Sect. 2.2 names the direct,
+//! composite-body and articulated-body methods): the default composite-body
+//! path forms M as above and leaves the solve M q̈ = Q − k to the integrator
+//! (dense Cholesky, O(n³)). The articulated-body formalism (open trees only)
+//! additionally solves M x = b in O(n) without forming M
+//! ([`Equations::solve_mass`]) by the articulated-body recursion of
+//! Featherstone (Rigid Body Dynamics Algorithms, 2008, Sect. 7.3) written in
+//! absolute coordinates: spatial vectors in SC0 axes about each tree's root
+//! point o, one scalar node per generalized coordinate (a body with several
+//! coordinates is a chain of massless nodes ending in the body's inertia), so
+//! no coordinate transforms between links are needed. The velocity-product
+//! terms of the ABA are not repeated inside the recursion: k comes from the
+//! engine's O(n) Newton–Euler pass above, and the recursion is run on
+//! τ = Q − k with zero velocity terms, which gives q̈ = M⁻¹(Q − k) exactly as
+//! the full ABA does (its passes 2 and 3 are linear in τ − k).
 
 use crate::equations::{BodyKinematics, Equations, Evaluation, Parts};
 use crate::system::SimError;
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 use railmbs_models::{
     Axis, BodyRef, Component, CutJoint, ElementaryKind, Expr, Frame, Model, Motion,
 };
@@ -153,9 +169,38 @@ struct FrameState {
     alpha0: Vector3<f64>,
 }
 
+/// How the numeric engine obtains q̈ (Pogorelov 2005, Sect. 2.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Formalism {
+    /// Composite-body method: M (O(n²)) for the integrator's Cholesky solve.
+    /// The default, and the only one for closed loops and Park's method.
+    #[default]
+    CompositeBody,
+    /// Articulated-body method (Featherstone 2008, Sect. 7.3): M x = b solved
+    /// in O(n) without M ([`Equations::solve_mass`]); open trees only. M is
+    /// still computed (by composite bodies) whenever it is asked for.
+    ArticulatedBody,
+}
+
 /// The numeric-iterative engine of one model.
 #[derive(Debug, Clone)]
 pub struct NumericEquations {
+    formalism: Formalism,
+    /// Body names (for messages).
+    body_names: Vec<String>,
+    /// Whether the last forward pass filled `inertia_global` and `axes`
+    /// (what [`Equations::solve_mass`] works on).
+    inertia_current: bool,
+    /// Articulated-body work buffers: per body the articulated inertia (6×6,
+    /// spatial, about the tree's root point, SC0 axes) and bias force it
+    /// passes to its parent, and its spatial acceleration; per coordinate
+    /// U = I^A s, D = sᵀ U and u = τ − sᵀ p^A (Featherstone 2008, Sect. 7.3).
+    art_inertia: Vec<Matrix6<f64>>,
+    art_bias: Vec<Vector6<f64>>,
+    art_acc: Vec<Vector6<f64>>,
+    node_u: Vec<Vector6<f64>>,
+    node_d: Vec<f64>,
+    node_tau: Vec<f64>,
     bodies: Vec<BodyData>,
     children: Vec<Vec<usize>>,
     coordinate_count: usize,
@@ -413,6 +458,15 @@ impl NumericEquations {
         let constraint_count = cuts.iter().map(|c| c.components.len()).sum();
         let nb = bodies.len();
         Self {
+            formalism: Formalism::CompositeBody,
+            body_names: model.bodies.iter().map(|b| b.name.clone()).collect(),
+            inertia_current: false,
+            art_inertia: vec![Matrix6::zeros(); nb],
+            art_bias: vec![Vector6::zeros(); nb],
+            art_acc: vec![Vector6::zeros(); nb],
+            node_u: vec![Vector6::zeros(); n],
+            node_d: vec![0.0; n],
+            node_tau: vec![0.0; n],
             bodies,
             children,
             coordinate_count: n,
@@ -437,6 +491,132 @@ impl NumericEquations {
             subtree_force: vec![Vector3::zeros(); nb],
             subtree_moment: vec![Vector3::zeros(); nb],
         }
+    }
+
+    /// [`NumericEquations::new`] with the given formalism. The
+    /// articulated-body method needs an open tree: a model with cut joints
+    /// (closed loops) is refused with an error naming the model and its cut
+    /// joints (no silent fallback: the user asked for O(n) and would not get
+    /// it; the composite-body formalism handles loops).
+    pub fn with_formalism(model: &Model, formalism: Formalism) -> Result<Self, SimError> {
+        if formalism == Formalism::ArticulatedBody && !model.cut_joints.is_empty() {
+            let names: Vec<&str> = model.cut_joints.iter().map(|c| c.name.as_str()).collect();
+            return Err(SimError::Other(format!(
+                "model \"{}\" has closed loops (cut joints {}): the articulated-body \
+                 method needs an open tree; use the composite-body formalism \
+                 (--engine numeric)",
+                model.name,
+                names.join(", ")
+            )));
+        }
+        let mut e = Self::new(model);
+        e.formalism = formalism;
+        Ok(e)
+    }
+
+    /// The formalism this engine uses for q̈.
+    pub fn formalism(&self) -> Formalism {
+        self.formalism
+    }
+
+    /// Motion vector (angular, linear) of every coordinate about its tree's
+    /// root point o (a point of the mechanism, so no digits are lost far
+    /// from SC0): (u, (p − o) × u) for a rotation, (0, u) for a translation.
+    fn motion_vectors(&mut self) {
+        for ((m, ax), &body) in self
+            .motion
+            .iter_mut()
+            .zip(&self.axes)
+            .zip(&self.coordinate_body)
+        {
+            let o = self.states[self.bodies[body].root].r;
+            let (a, b) = if ax.rotation {
+                (ax.u, (ax.p - o).cross(&ax.u))
+            } else {
+                (Vector3::zeros(), ax.u)
+            };
+            *m = [a.x, a.y, a.z, b.x, b.y, b.z];
+        }
+    }
+
+    /// Spatial inertia of body `j` about its tree's root point o in SC0 axes
+    /// (motion vectors (ω, v_o), force vectors (n_o, f)): with d = c − o,
+    /// `[[I_c + m d̃ d̃ᵀ, m d̃], [m d̃ᵀ, m E]]` (Featherstone 2008, ch. 2: the rigid-body inertia
+    /// about a point other than the centre of mass).
+    fn spatial_inertia(&self, j: usize) -> Matrix6<f64> {
+        let m = self.bodies[j].mass;
+        let d = self.states[j].r - self.states[self.bodies[j].root].r;
+        let md = m * d;
+        // m d̃ (cross-product matrix of m d).
+        let c = Matrix3::new(0.0, -md.z, md.y, md.z, 0.0, -md.x, -md.y, md.x, 0.0);
+        let rot = self.inertia_global[j] + steiner(m, &d);
+        let mut out = Matrix6::zeros();
+        out.fixed_view_mut::<3, 3>(0, 0).copy_from(&rot);
+        out.fixed_view_mut::<3, 3>(0, 3).copy_from(&c);
+        out.fixed_view_mut::<3, 3>(3, 0).copy_from(&c.transpose());
+        out.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&Matrix3::from_diagonal_element(m));
+        out
+    }
+
+    /// Solves M x = b in place (b: generalized forces, N or N m; x: q̈, m/s²
+    /// or rad/s²) by the articulated-body recursion (Featherstone 2008,
+    /// Sect. 7.3, passes 2 and 3 with zero velocity terms, in absolute
+    /// coordinates), O(n), at the kinematics of the last forward pass.
+    ///
+    /// Backward, per body (children first), then per own coordinate from the
+    /// last to the first: I^A = I_j + Σ_children I^a, p^A = Σ_children p^a;
+    /// U = I^A s, D = sᵀ U, u = b_k − sᵀ p^A; I^a = I^A − U Uᵀ / D,
+    /// p^a = p^A + U u / D. Forward: a = a_parent; x_k = (u − Uᵀ a) / D;
+    /// a += s x_k. A body without coordinates passes I^A, p^A on unchanged
+    /// (it moves rigidly with its parent as far as q̈ is concerned).
+    fn articulated_solve(&mut self, b: &mut [f64]) -> Result<(), SimError> {
+        self.motion_vectors();
+        let nb = self.bodies.len();
+        for j in (0..nb).rev() {
+            let mut ia = self.spatial_inertia(j);
+            let mut pa = Vector6::zeros();
+            for &c in &self.children[j] {
+                ia += self.art_inertia[c];
+                pa += self.art_bias[c];
+            }
+            let body = &self.bodies[j];
+            for &k in body.chain[body.own_start..].iter().rev() {
+                let s = Vector6::from_column_slice(&self.motion[k]);
+                let u = ia * s;
+                let d = s.dot(&u);
+                if !(d > 0.0 && d.is_finite()) {
+                    return Err(SimError::Other(format!(
+                        "articulated-body method: the articulated inertia of coordinate {k} \
+                         (body \"{}\") about its axis is {d}, not positive (a massless \
+                         subtree or a singular joint axis)",
+                        self.body_names[j]
+                    )));
+                }
+                let tau = b[k] - s.dot(&pa);
+                ia -= u * (u.transpose() / d);
+                pa += u * (tau / d);
+                self.node_u[k] = u;
+                self.node_d[k] = d;
+                self.node_tau[k] = tau;
+            }
+            self.art_inertia[j] = ia;
+            self.art_bias[j] = pa;
+        }
+        for j in 0..nb {
+            let body = &self.bodies[j];
+            let mut a = match body.parent {
+                Some(p) => self.art_acc[p],
+                None => Vector6::zeros(),
+            };
+            for &k in &body.chain[body.own_start..] {
+                let x = (self.node_tau[k] - self.node_u[k].dot(&a)) / self.node_d[k];
+                a += Vector6::from_column_slice(&self.motion[k]) * x;
+                b[k] = x;
+            }
+            self.art_acc[j] = a;
+        }
+        Ok(())
     }
 
     /// Compiles the joint transformations of every body into `steps` with the
@@ -682,22 +862,7 @@ impl NumericEquations {
             self.composite_center[j] = rj + dc;
             self.composite_inertia[j] = inertia;
         }
-        // Motion vectors of the coordinates about their tree's root point o
-        // (a point of the mechanism, so no digits are lost far from SC0).
-        for ((m, ax), &body) in self
-            .motion
-            .iter_mut()
-            .zip(&self.axes)
-            .zip(&self.coordinate_body)
-        {
-            let o = self.states[self.bodies[body].root].r;
-            let (a, b) = if ax.rotation {
-                (ax.u, (ax.p - o).cross(&ax.u))
-            } else {
-                (Vector3::zeros(), ax.u)
-            };
-            *m = [a.x, a.y, a.z, b.x, b.y, b.z];
-        }
+        self.motion_vectors();
         let n = mass.nrows();
         let ms = mass.as_mut_slice(); // column-major: (r, c) at r + c n
         for (b, body) in self.bodies.iter().enumerate() {
@@ -948,7 +1113,33 @@ fn rotate_principal(a: &Matrix3<f64>, d: &Vector3<f64>) -> Matrix3<f64> {
 
 impl Equations for NumericEquations {
     fn engine_name(&self) -> &str {
-        "numeric"
+        match self.formalism {
+            Formalism::CompositeBody => "numeric",
+            Formalism::ArticulatedBody => "numeric-aba",
+        }
+    }
+    fn solves_mass(&self) -> bool {
+        self.formalism == Formalism::ArticulatedBody
+    }
+    fn solve_mass(&mut self, b: &mut [f64]) -> Result<bool, SimError> {
+        if self.formalism != Formalism::ArticulatedBody {
+            return Ok(false);
+        }
+        if b.len() != self.coordinate_count {
+            return Err(SimError::Other(format!(
+                "solve_mass: right-hand side has {} entries, the model has {} coordinates",
+                b.len(),
+                self.coordinate_count
+            )));
+        }
+        if !self.inertia_current {
+            return Err(SimError::Other(
+                "solve_mass called before an evaluation of the bias terms or the mass matrix"
+                    .into(),
+            ));
+        }
+        self.articulated_solve(b)?;
+        Ok(true)
     }
     fn dof(&self) -> usize {
         self.coordinate_count
@@ -1045,6 +1236,7 @@ impl Equations for NumericEquations {
         }
         self.check_buffers(parts, out)?;
         self.forward(t, q, v, parts.bias, parts.mass || parts.bias);
+        self.inertia_current = parts.mass || parts.bias;
         if parts.kinematics {
             for (k, s) in out.bodies.iter_mut().zip(&self.states) {
                 let BodyKinematics {

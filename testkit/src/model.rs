@@ -45,3 +45,56 @@ pub fn all_vehicles() -> Vec<Model> {
 fn load(path: &Path) -> Model {
     railmbs_models::load_model(path).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// The text of a generated open chain of `n` links (for chains longer than
+/// the bundled ones, tests and benches of the articulated-body method).
+///
+/// `spatial == false`: the planar chain of `models/tools/gen_chains.py`
+/// (1 kg, 1 m links, centre of mass at mid-link, Izz = Ixx = 1/12,
+/// Iyy = 1e-4 kg m², revolute joints about z, gravity 9.81 m/s² along −y,
+/// q0(0) = 0.5 rad). `spatial == true`: the same links with joint axes
+/// cycling z, x, y, the centre of mass off the link axis (0.05, −0.5,
+/// 0.02) m and a full inertia tensor (products of inertia nonzero), every
+/// joint starting at 0.3 sin(i) rad: a chain whose motion is not planar.
+pub fn chain_text(n: usize, spatial: bool) -> String {
+    let mut s = format!(
+        "Model(\n    name: \"{}chain{n}\",\n    description: \"generated chain of {n} links\",\n    \
+         gravity: (0, -9.81, 0),\n    bodies: [\n",
+        if spatial { "spatial_" } else { "" }
+    );
+    for i in 0..n {
+        let parent = if i == 0 {
+            "ground".to_string()
+        } else {
+            format!("link{}", i - 1)
+        };
+        let at = if i == 0 { "(0, 0, 0)" } else { "(0, -0.5, 0)" };
+        let (axis, inertia, init, com) = if spatial {
+            (
+                ["Z", "X", "Y"][i % 3],
+                "(ixx: 0.09, iyy: 0.02, izz: 0.08, ixy: 0.004, ixz: -0.002, iyz: 0.003)",
+                0.3 * (i as f64).sin(),
+                "(0.05, -0.5, 0.02)",
+            )
+        } else {
+            (
+                "Z",
+                "(ixx: \"1/12\", iyy: 1e-4, izz: \"1/12\")",
+                if i == 0 { 0.5 } else { 0.0 },
+                "(0, -0.5, 0)",
+            )
+        };
+        s += &format!(
+            "        Body(name: \"link{i}\", mass: 1.0, inertia: {inertia},\n            \
+             joint: Revolute(parent: \"{parent}\", at: {at}, axis: {axis}, coord: \"q{i}\", \
+             init: {init}, vel: 0.0, to_com: {com})),\n"
+        );
+    }
+    s += "    ],\n)\n";
+    s
+}
+
+/// The generated chain of [`chain_text`], parsed.
+pub fn chain(n: usize, spatial: bool) -> Model {
+    parse(&chain_text(n, spatial))
+}

@@ -22,6 +22,7 @@ pub fn process_cpu(scenario: &Path, engine: Engine) -> Result<f64, String> {
     let engine = match engine {
         Engine::Numeric => "numeric",
         Engine::Symbolic => "symbolic",
+        Engine::NumericAba => "numeric-aba",
     };
     let once = || -> Result<f64, String> {
         let out = Command::new(&exe)

@@ -1,6 +1,7 @@
 //! The integration tests of `runtime`, one module per topic, linked into one
 //! test binary.
 
+mod aba;
 mod force_elements;
 mod force_elements_contact;
 mod force_elements_decay;
