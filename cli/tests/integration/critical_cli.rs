@@ -51,7 +51,7 @@ fn bad_detection_settings_and_plots_without_a_locus_are_named() {
     ]);
     assert!(!out.status.success());
     assert!(
-        text(&out.stderr).contains("--plot needs --speed or --sweep"),
+        text(&out.stderr).contains("--plot needs --speed, --sweep or --conicity"),
         "{}",
         text(&out.stderr)
     );
