@@ -567,6 +567,10 @@ impl ProfileValue {
     }
 }
 
+/// The largest lateral extent of a profile's points, m: five times a wheel
+/// profile's width (a rail with its foot spans 0.15 m).
+pub const MAX_LATERAL_EXTENT: f64 = 0.75;
+
 impl Profile {
     /// Builds a smooth profile from points. For a rail, the inclination of `settings` is applied
     /// first, parts folding back under the head after rotation are trimmed, and the origin is
@@ -596,6 +600,24 @@ impl Profile {
             return Err(bad(format!(
                 "rail inclination must be finite and below 0.5 rad in magnitude, got {}",
                 settings.rail_inclination
+            )));
+        }
+        // A wheel's profile spans about 0.14 m laterally and a rail's head
+        // 0.07 m (with its foot 0.15 m); the contact search samples the
+        // profile every 0.25 mm, so an extent of kilometres (a value in mm
+        // read as m, or a stray point) would allocate without bound.
+        let (lo, hi) = points
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[0]), hi.max(p[0]))
+            });
+        if hi - lo > MAX_LATERAL_EXTENT {
+            return Err(bad(format!(
+                "the points span {:.4} m laterally (from {lo} to {hi} m), more than the {} m \
+                 a wheel or rail profile can: check the units (files are in mm) and for stray points",
+                hi - lo,
+                MAX_LATERAL_EXTENT
             )));
         }
         let mut pts = points.points.clone();

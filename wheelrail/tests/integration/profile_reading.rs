@@ -358,3 +358,20 @@ fn uic60_prr_is_inclined_1_in_40_and_rotates_back_to_a_symmetric_head() {
         u += 0.5e-3;
     }
 }
+
+/// A profile spanning kilometres (the `profile` fuzz target's out-of-memory
+/// input: a point at −7 000 000 mm among a wheel's) is refused with its
+/// extent named, before the contact search samples it every 0.25 mm.
+#[test]
+fn a_profile_spanning_kilometres_is_refused_before_it_is_sampled() {
+    let text = "-7000000. 900\n-69.865 -10.95\n0 0\n60 1\n";
+    let points = parse_points(text, "huge", ProfileFormat::TwoColumn, ProfileKind::Wheel)
+        .expect("the points themselves are readable");
+    let e = Profile::from_points(&points, &ProfileSettings::default())
+        .expect_err("a 7 km wide profile");
+    let message = e.to_string();
+    assert!(
+        message.contains("huge") && message.contains("span 7000.0600 m laterally"),
+        "{message}"
+    );
+}
