@@ -1,32 +1,12 @@
 //! Contact geometry: symmetry, analytic cone, S1002 on UIC60 1:40 two-point contact, tables.
 
-use railmbs_testkit::model_path;
+use crate::common::s1002_uic60;
 use railmbs_wheelrail::conicity::{RollTreatment, RollingRadiusDifference, conicity_curve};
 use railmbs_wheelrail::geometry::{
     Contact, ContactGeometry, ContactTable, GeometryError, SearchSettings, TableSettings, Track,
     Wheelset,
 };
 use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfilePoints, ProfileSettings};
-
-fn s1002_uic60() -> (Wheelset, Track) {
-    let s = ProfileSettings::default();
-    let w = Profile::read(
-        &model_path("profiles/MBench_S1002_v3.prw"),
-        ProfileKind::Wheel,
-        &s,
-    )
-    .unwrap();
-    let r = Profile::read(
-        &model_path("profiles/MBench_UIC60_v3.prr"),
-        ProfileKind::Rail,
-        &s,
-    )
-    .unwrap();
-    (
-        Wheelset::new(w.clone(), w, 0.46, 1.360),
-        Track::new(r.clone(), r, 1.435),
-    )
-}
 
 #[test]
 fn centred_symmetric_wheelset_has_mirror_contacts() {

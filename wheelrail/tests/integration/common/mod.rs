@@ -1,17 +1,19 @@
 //! Helpers shared by the creep-law tests: CONTACT's reference results
 //! (`../shared/reference/contact`, E.A.H. Vollebregt) and a typical tread
-//! contact patch.
+//! contact patch, the bundled S1002/UIC60 pair.
 #![allow(dead_code)]
 
-use railmbs_testkit::reference_path;
+use railmbs_testkit::{model_path, reference_path};
 use railmbs_wheelrail::creep::{ContactPatch, Creepages};
+use railmbs_wheelrail::geometry::{Track, Wheelset};
+use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
 use std::collections::HashMap;
+use std::path::Path;
 
-/// Rows of a CONTACT result CSV as (header → value) lookups (numeric
-/// columns only).
-pub fn contact_rows(file: &str) -> Vec<HashMap<String, f64>> {
-    let mut rd =
-        csv::Reader::from_path(reference_path("contact").join(file)).expect("reference CSV");
+/// Rows of a CSV file as (header → value) lookups (numeric columns only).
+pub fn csv_rows(path: &Path) -> Vec<HashMap<String, f64>> {
+    let mut rd = csv::Reader::from_path(path)
+        .unwrap_or_else(|e| panic!("reference CSV {}: {e}", path.display()));
     let hdr = rd.headers().unwrap().clone();
     rd.records()
         .map(|r| {
@@ -22,6 +24,33 @@ pub fn contact_rows(file: &str) -> Vec<HashMap<String, f64>> {
                 .collect()
         })
         .collect()
+}
+
+/// Rows of a CONTACT result CSV of `../shared/reference/contact` ([`csv_rows`]).
+pub fn contact_rows(file: &str) -> Vec<HashMap<String, f64>> {
+    csv_rows(&reference_path("contact").join(file))
+}
+
+/// The bundled S1002 wheelset (r0 0.46 m, 1360 mm back-to-back) on UIC60
+/// 1:40 rails at 1435 mm gauge, default profile settings.
+pub fn s1002_uic60() -> (Wheelset, Track) {
+    let s = ProfileSettings::default();
+    let w = Profile::read(
+        &model_path("profiles/MBench_S1002_v3.prw"),
+        ProfileKind::Wheel,
+        &s,
+    )
+    .unwrap();
+    let r = Profile::read(
+        &model_path("profiles/MBench_UIC60_v3.prr"),
+        ProfileKind::Rail,
+        &s,
+    )
+    .unwrap();
+    (
+        Wheelset::new(w.clone(), w, 0.46, 1.360),
+        Track::new(r.clone(), r, 1.435),
+    )
 }
 
 /// A CONTACT case in CONTACT's units (mm, N, N/mm², spin rad/mm) → SI.
