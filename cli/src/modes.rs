@@ -410,15 +410,7 @@ fn plot_critical_over(
     output: Option<&std::path::Path>,
     table: &[CriticalAtConicity],
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let csv = plot.with_extension("csv");
-    if output == Some(csv.as_path()) {
-        return Err(format!(
-            "--plot {} would write its data over the -o file {}",
-            plot.display(),
-            csv.display()
-        )
-        .into());
-    }
+    let csv = plot_data_path(plot, output)?;
     let found: Vec<CriticalAtConicity> = table
         .iter()
         .filter(|(_, v, _)| v.is_some())
@@ -445,6 +437,23 @@ fn plot_critical_over(
         csv.display()
     );
     Ok(())
+}
+
+/// The CSV a plot's data is written to, beside the plot (its name with
+/// `.csv`); an error if that is the `-o` file.
+fn plot_data_path(
+    plot: &std::path::Path,
+    output: Option<&std::path::Path>,
+) -> Result<std::path::PathBuf, String> {
+    let csv = plot.with_extension("csv");
+    if output == Some(csv.as_path()) {
+        return Err(format!(
+            "--plot {} would write its data over the -o file {}",
+            plot.display(),
+            csv.display()
+        ));
+    }
+    Ok(csv)
 }
 
 fn csv_error(path: &std::path::Path, e: impl std::fmt::Display) -> String {
@@ -573,15 +582,7 @@ fn plot_locus_over(
     locus: &[SpeedModes],
     axis: &Axis,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let csv = plot.with_extension("csv");
-    if output == Some(csv.as_path()) {
-        return Err(format!(
-            "--plot {} would write its data over the -o file {}",
-            plot.display(),
-            csv.display()
-        )
-        .into());
-    }
+    let csv = plot_data_path(plot, output)?;
     let mut w = csv::Writer::from_path(&csv).map_err(|e| csv_error(&csv, e))?;
     w.write_record([axis.label, "zeta[-]", "f[Hz]"])
         .map_err(|e| csv_error(&csv, e))?;
