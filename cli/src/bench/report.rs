@@ -14,6 +14,10 @@ pub struct EngineTimes {
     pub run_s: Option<f64>,
     /// Integration steps of the scenario run.
     pub run_steps: Option<usize>,
+    /// Wall time of the scenario run, s, for a train whose vehicles step on
+    /// worker threads (`threads` > 1); its `run_s` is then the process's CPU
+    /// time over all threads.
+    pub run_wall_s: Option<f64>,
     /// CPU time of a whole `umsim run` process of the scenario, caches warm
     /// (start-up, run, CSV output), s.
     pub process_s: Option<f64>,
@@ -119,6 +123,8 @@ impl BenchReport {
             "symbolic_run_s": self.symbolic.run_s,
             "run_ratio": self.run_ratio(),
             "numeric_run_steps": self.numeric.run_steps,
+            "numeric_run_wall_s": self.numeric.run_wall_s,
+            "symbolic_run_wall_s": self.symbolic.run_wall_s,
             "numeric_process_s": self.numeric.process_s,
             "symbolic_process_s": self.symbolic.process_s,
             "symbolic_run_steps": self.symbolic.run_steps,
@@ -219,6 +225,21 @@ impl BenchReport {
         ];
         for (label, a, b, c) in rows {
             let _ = writeln!(s, "{label:<28} {a:>14} {b:>14} {c:>18}");
+        }
+        if self.numeric.run_wall_s.is_some() || self.symbolic.run_wall_s.is_some() {
+            let _ = writeln!(
+                s,
+                "{:<28} {:>14} {:>14} {:>18}",
+                "wall time per step",
+                per_step(self.numeric.run_wall_s, self.numeric.run_steps),
+                per_step(self.symbolic.run_wall_s, self.symbolic.run_steps),
+                ""
+            );
+            let _ = writeln!(
+                s,
+                "(the vehicles step on worker threads: CPU time is the process's, summed over \
+                 its threads)"
+            );
         }
         if let Some([chol, factor, solve]) = self.linear_ns {
             let _ = writeln!(

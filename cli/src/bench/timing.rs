@@ -1,5 +1,6 @@
-//! How `umsim bench` times: a stopwatch on the thread's CPU clock, the
-//! batch-doubling loop for evaluations and the median of repeated runs.
+//! How `umsim bench` times: a stopwatch on the thread's CPU clock (or on the
+//! process's, for runs that use worker threads), the batch-doubling loop for
+//! evaluations and the median of repeated runs.
 
 use std::time::Instant;
 
@@ -12,26 +13,51 @@ pub const RUN_SECONDS: f64 = 1.0;
 /// Most scenario runs per engine.
 pub const MAX_RUNS: usize = 5;
 
-/// A stopwatch on the thread's CPU clock (the `cpu-time` crate), or on the wall
-/// clock where the platform has none.
+/// The CPU clock a [`Stopwatch`] reads.
+enum CpuClock {
+    /// The calling thread's: other processes on a busy machine do not count.
+    Thread(cpu_time::ThreadTime),
+    /// The whole process's, summed over its threads: for work that runs on
+    /// worker threads (a train with `threads` > 1), which the calling
+    /// thread's clock would not see.
+    Process(cpu_time::ProcessTime),
+    /// None available: the wall clock stands in.
+    Wall,
+}
+
+/// A stopwatch on a CPU clock (the `cpu-time` crate), or on the wall clock
+/// where the platform has none, that also keeps the wall time.
 pub(crate) struct Stopwatch {
-    cpu: Option<cpu_time::ThreadTime>,
+    cpu: CpuClock,
     wall: Instant,
 }
 
 impl Stopwatch {
+    /// On the calling thread's CPU clock.
     pub(crate) fn start() -> Self {
         Self {
-            cpu: cpu_time::ThreadTime::try_now().ok(),
+            cpu: cpu_time::ThreadTime::try_now().map_or(CpuClock::Wall, CpuClock::Thread),
             wall: Instant::now(),
         }
     }
-    /// Seconds since `start`.
+    /// On the process's CPU clock (all its threads).
+    pub(crate) fn start_process() -> Self {
+        Self {
+            cpu: cpu_time::ProcessTime::try_now().map_or(CpuClock::Wall, CpuClock::Process),
+            wall: Instant::now(),
+        }
+    }
+    /// CPU seconds since the start.
     pub(crate) fn seconds(&self) -> f64 {
         match &self.cpu {
-            Some(t) => t.elapsed().as_secs_f64(),
-            None => self.wall.elapsed().as_secs_f64(),
+            CpuClock::Thread(t) => t.elapsed().as_secs_f64(),
+            CpuClock::Process(t) => t.elapsed().as_secs_f64(),
+            CpuClock::Wall => self.wall_seconds(),
         }
+    }
+    /// Wall-clock seconds since the start.
+    pub(crate) fn wall_seconds(&self) -> f64 {
+        self.wall.elapsed().as_secs_f64()
     }
 }
 

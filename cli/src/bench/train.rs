@@ -27,24 +27,42 @@ pub(super) fn is_train_file(path: &Path) -> bool {
 /// Builds the engine of one vehicle's model.
 type VehicleEngines = dyn Fn(&Model) -> Result<Box<dyn Equations>, String>;
 
-/// Median time of `run_train` (no CSV) with every vehicle's engine from
-/// `make`, s, and the steps of a run.
+/// Median CPU time of `run_train` (no CSV) with every vehicle's engine from
+/// `make`, s, and the steps of a run, recorded in `times`. A train with
+/// `threads` > 1 steps its vehicles on worker threads, so its CPU time is
+/// the process's (all threads), and its median wall time is recorded too:
+/// what the threads save.
 fn time_train_run(
     train: &railmbs_models::TrainScenario,
     models: &[Model],
     make: &VehicleEngines,
-) -> Result<(f64, usize), String> {
+    times: &mut EngineTimes,
+) -> Result<(), String> {
     let refs: Vec<&Model> = models.iter().collect();
-    median_run(|| {
+    let threaded = train.threads > 1;
+    let mut walls = Vec::new();
+    let (t, n) = median_run(|| {
         let engines = models.iter().map(make).collect::<Result<Vec<_>, _>>()?;
-        let watch = Stopwatch::start();
+        let watch = if threaded {
+            Stopwatch::start_process()
+        } else {
+            Stopwatch::start()
+        };
         let summary = run_train(train, &refs, engines, None, |_| {}).map_err(|e| e.to_string())?;
         let seconds = watch.seconds();
+        walls.push(watch.wall_seconds());
         match summary.error {
             Some(e) => Err(format!("the train run failed: {e}")),
             None => Ok((seconds, summary.steps)),
         }
-    })
+    })?;
+    times.run_s = Some(t);
+    times.run_steps = Some(n);
+    if threaded {
+        walls.sort_by(f64::total_cmp);
+        times.run_wall_s = Some(walls[walls.len() / 2]);
+    }
+    Ok(())
 }
 
 /// `measure` for a train file: evaluations summed over the vehicles, the
@@ -119,11 +137,12 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
         }
     }
     numeric.eval_ns = numeric_sum;
-    let (t, n) = time_train_run(&train, &models, &|m| {
-        build_engine(m, Engine::Numeric, None).map_err(|e| e.to_string())
-    })?;
-    numeric.run_s = Some(t);
-    numeric.run_steps = Some(n);
+    time_train_run(
+        &train,
+        &models,
+        &|m| build_engine(m, Engine::Numeric, None).map_err(|e| e.to_string()),
+        &mut numeric,
+    )?;
     whole_process(&train.source, Engine::Numeric, args, &mut numeric);
     if args.engine == BenchEngine::Numeric {
         symbolic.note = Some("not requested (--engine numeric)".into());
@@ -131,11 +150,14 @@ pub(super) fn measure_train(args: &Args) -> Result<BenchReport, Box<dyn std::err
     } else if symbolic.note.is_none() {
         symbolic.eval_ns = symbolic_sum;
         let portable = args.portable;
-        let (t, n) = time_train_run(&train, &models, &move |m| {
-            build_engine_with(m, Engine::Symbolic, None, portable).map_err(|e| e.to_string())
-        })?;
-        symbolic.run_s = Some(t);
-        symbolic.run_steps = Some(n);
+        time_train_run(
+            &train,
+            &models,
+            &move |m| {
+                build_engine_with(m, Engine::Symbolic, None, portable).map_err(|e| e.to_string())
+            },
+            &mut symbolic,
+        )?;
         whole_process(&train.source, Engine::Symbolic, args, &mut symbolic);
     } else {
         (derive_s, compile_s) = (None, None);

@@ -130,6 +130,8 @@ fn bench_of_a_train_sums_its_vehicles_and_runs_the_train() {
     positive(&v, "numeric_eval_ns");
     positive(&v, "numeric_run_s");
     assert!(v["symbolic_run_s"].is_null());
+    // Sequential: the run time is the calling thread's CPU, no wall time.
+    assert!(v["numeric_run_wall_s"].is_null());
     // A train is its own scenario.
     let o = umsim(&[
         "bench",
@@ -139,4 +141,31 @@ fn bench_of_a_train_sums_its_vehicles_and_runs_the_train() {
     ]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("train file"));
+}
+
+/// A train whose vehicles step on two worker threads: its run time is the
+/// process's CPU time (all threads) and the wall time is reported beside it;
+/// a sequential train has no wall time (the test above).
+#[test]
+fn bench_of_a_threaded_train_reports_process_cpu_and_wall_time() {
+    let repo = railmbs_testkit::repo_path("models");
+    let text = std::fs::read_to_string(repo.join("scenarios/train3_straight.ron"))
+        .expect("train3_straight.ron")
+        .replace("\"../", &format!("\"{}/", repo.display()))
+        .replace("end_time: 3.0,", "end_time: 0.2,\n    threads: 2,");
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let file = dir.path().join("train3_threads2.ron");
+    std::fs::write(&file, text).expect("write the train");
+    let v = json(&umsim(&[
+        "bench",
+        file.to_str().expect("UTF-8 path"),
+        "--json",
+        "--engine",
+        "numeric",
+        "--states",
+        "2",
+    ]));
+    positive(&v, "numeric_run_s");
+    positive(&v, "numeric_run_wall_s");
+    assert!(v["symbolic_run_wall_s"].is_null());
 }
