@@ -338,11 +338,15 @@ impl MeasuredIrregularity {
             ));
         }
         for i in 0..s.len() {
-            check_param(
-                &format!("measured irregularity sample {i} position"),
-                s[i],
-                false,
-            )?;
+            // The element's name is formatted only for an error (a sampled
+            // stochastic irregularity has tens of thousands of samples).
+            if !s[i].is_finite() {
+                check_param(
+                    &format!("measured irregularity sample {i} position"),
+                    s[i],
+                    false,
+                )?;
+            }
             let v = &values[i];
             for x in [
                 v.left_lateral,
@@ -350,7 +354,9 @@ impl MeasuredIrregularity {
                 v.right_lateral,
                 v.right_vertical,
             ] {
-                check_param(&format!("measured irregularity sample {i} value"), x, false)?;
+                if !x.is_finite() {
+                    check_param(&format!("measured irregularity sample {i} value"), x, false)?;
+                }
             }
             if i > 0 && s[i] <= s[i - 1] {
                 return Err(invalid(
