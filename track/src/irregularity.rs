@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use crate::error::{TrackError, check_param, finite, invalid};
-use crate::psd::StochasticIrregularity;
+use crate::psd::{SampledIrregularity, StochasticIrregularity};
 
 /// Per-rail deviations from the design geometry, m (or m/m for rates).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -479,27 +479,48 @@ impl MeasuredIrregularity {
         if s < self.s[0] || s > self.s[n - 1] {
             return Default::default();
         }
-        let i = (self.s.partition_point(|&k| k <= s).max(1) - 1).min(n - 2);
-        let (a, b) = (&self.values[i], &self.values[i + 1]);
-        let h = self.s[i + 1] - self.s[i];
-        let t = (s - self.s[i]) / h;
-        let lerp = |x: f64, y: f64| x + (y - x) * t;
-        let rate = |x: f64, y: f64| (y - x) / h;
-        (
-            RailDeviation {
-                left_lateral: lerp(a.left_lateral, b.left_lateral),
-                left_vertical: lerp(a.left_vertical, b.left_vertical),
-                right_lateral: lerp(a.right_lateral, b.right_lateral),
-                right_vertical: lerp(a.right_vertical, b.right_vertical),
-            },
-            RailDeviation {
-                left_lateral: rate(a.left_lateral, b.left_lateral),
-                left_vertical: rate(a.left_vertical, b.left_vertical),
-                right_lateral: rate(a.right_lateral, b.right_lateral),
-                right_vertical: rate(a.right_vertical, b.right_vertical),
-            },
+        let i = interval(&self.s, s);
+        interpolate(
+            s,
+            (self.s[i], self.s[i + 1]),
+            (&self.values[i], &self.values[i + 1]),
         )
     }
+}
+
+/// The sample interval [s_i, s_i+1] of the strictly increasing positions
+/// `positions` (at least two) that holds `s`: the last i with s_i ≤ s, at
+/// most the last but one.
+pub(crate) fn interval(positions: &[f64], s: f64) -> usize {
+    let n = positions.len();
+    (positions.partition_point(|&k| k <= s).max(1) - 1).min(n - 2)
+}
+
+/// Deviation and its s-derivative at `s` between the samples `a` at `s0`
+/// and `b` at `s1`, by linear interpolation.
+pub(crate) fn interpolate(
+    s: f64,
+    (s0, s1): (f64, f64),
+    (a, b): (&RailDeviation, &RailDeviation),
+) -> (RailDeviation, RailDeviation) {
+    let h = s1 - s0;
+    let t = (s - s0) / h;
+    let lerp = |x: f64, y: f64| x + (y - x) * t;
+    let rate = |x: f64, y: f64| (y - x) / h;
+    (
+        RailDeviation {
+            left_lateral: lerp(a.left_lateral, b.left_lateral),
+            left_vertical: lerp(a.left_vertical, b.left_vertical),
+            right_lateral: lerp(a.right_lateral, b.right_lateral),
+            right_vertical: lerp(a.right_vertical, b.right_vertical),
+        },
+        RailDeviation {
+            left_lateral: rate(a.left_lateral, b.left_lateral),
+            left_vertical: rate(a.left_vertical, b.left_vertical),
+            right_lateral: rate(a.right_lateral, b.right_lateral),
+            right_vertical: rate(a.right_vertical, b.right_vertical),
+        },
+    )
 }
 
 /// One irregularity of any kind.
@@ -515,6 +536,8 @@ pub enum Irregularity {
     Stochastic(StochasticIrregularity),
     /// Measured samples.
     Measured(MeasuredIrregularity),
+    /// A stochastic irregularity tabulated on first use.
+    Sampled(SampledIrregularity),
 }
 
 impl Irregularity {
@@ -526,6 +549,7 @@ impl Irregularity {
             Irregularity::GaugeWidening(x) => x.eval(s),
             Irregularity::Stochastic(x) => x.eval(s),
             Irregularity::Measured(x) => x.eval(s),
+            Irregularity::Sampled(x) => x.eval(s),
         }
     }
 }

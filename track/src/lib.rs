@@ -39,7 +39,7 @@ pub use irregularity::{
     Rail, RailDeviation, Sinusoid,
 };
 pub use profile::{PiecewiseLinear, VerticalPoint, VerticalProfile};
-pub use psd::{PsdModel, StochasticIrregularity, StochasticSpec};
+pub use psd::{PsdModel, SampledIrregularity, StochasticIrregularity, StochasticSpec};
 pub use spec::{IrregularitySpec, SectionSpec, TrackCase, TrackDescription, TrackSpec};
 pub use speed::{ArcMotion, ConstantSpeed, SpeedLaw, SpeedTable};
 pub use track::{

@@ -31,7 +31,8 @@ use std::f64::consts::PI;
 
 use crate::alignment::{GL8_W, GL8_X};
 use crate::error::{TrackError, check_param, invalid};
-use crate::irregularity::{Component, MeasuredIrregularity, RailDeviation};
+use crate::irregularity::{Component, MeasuredIrregularity, RailDeviation, interpolate, interval};
+use std::sync::OnceLock;
 
 /// ORE B176 Ωc, rad/m.
 pub const ERRI_OMEGA_C: f64 = 0.8246;
@@ -310,6 +311,32 @@ impl StochasticIrregularity {
     /// [`Self::sampled`], summing samples in blocks (`blocks`) or one at a
     /// time: the same table bit for bit (tested).
     fn sampled_in(&self, ds: f64, blocks: bool) -> Result<MeasuredIrregularity, TrackError> {
+        let s = self.sample_positions(ds)?;
+        let v = self.sample_values(ds, 0, s.len() - 1, blocks);
+        MeasuredIrregularity::from_samples(s, v)
+    }
+
+    /// The table of [`Self::sampled`], its values computed a chunk of
+    /// [`CHUNK`] samples at a time when a run first needs them: a short run
+    /// on a long track samples only the stretch it covers. Interpolates to
+    /// the same numbers bit for bit (tested).
+    ///
+    /// # Errors
+    /// As [`Self::sampled`]: a bad step, too many samples, or fewer than two.
+    pub fn sampled_lazily(&self, ds: f64) -> Result<SampledIrregularity, TrackError> {
+        let s = self.sample_positions(ds)?;
+        let chunks = (s.len() - 2) / CHUNK + 1;
+        Ok(SampledIrregularity {
+            source: self.clone(),
+            ds,
+            s,
+            chunks: (0..chunks).map(|_| OnceLock::new()).collect(),
+        })
+    }
+
+    /// The sample positions of the table every `ds` m: start + i ds up to
+    /// the extent's end (the last one clamped to it), at least two.
+    fn sample_positions(&self, ds: f64) -> Result<Vec<f64>, TrackError> {
         check_param("sampling step", ds, true)?;
         let n = ((self.end - self.start) / ds).ceil() as usize;
         if n > 50_000_000 {
@@ -318,18 +345,36 @@ impl StochasticIrregularity {
                 format!("{ds} m gives too many samples"),
             ));
         }
-        let mut s = Vec::with_capacity(n + 1);
-        let mut v = Vec::with_capacity(n + 1);
-        // Phasors z_k = exp(i(Ω_k x + φ_k)) advanced by w_k = exp(iΩ_k ds) per
-        // sample (a complex product instead of a sin_cos), recomputed exactly
-        // every RESEED samples so the rounding drift stays below ~1e-13
-        // relative.
-        const RESEED: usize = 256;
-        // Samples summed together: each sample's sum Σ a_k Re z_k runs over k
-        // in order (the same rounding as one at a time), and BLOCK of them
-        // are independent chains of additions that the processor overlaps.
-        const BLOCK: usize = 8;
-        const _: () = assert!(RESEED.is_multiple_of(BLOCK), "a block never spans a reseed");
+        let mut s: Vec<f64> = Vec::with_capacity(n + 1);
+        for i in 0..=n {
+            let x = self.sample_position(ds, i);
+            if let Some(&last) = s.last()
+                && x <= last
+            {
+                break;
+            }
+            s.push(x);
+        }
+        if s.len() < 2 {
+            return Err(invalid(
+                "measured irregularity",
+                "needs at least two samples",
+            ));
+        }
+        Ok(s)
+    }
+
+    /// Position of sample `i` of the table every `ds` m, m.
+    fn sample_position(&self, ds: f64, i: usize) -> f64 {
+        (self.start + i as f64 * ds).min(self.end)
+    }
+
+    /// The faded values of samples `from..=to` (`from` a multiple of
+    /// [`RESEED`], `to` a sample of [`Self::sample_positions`]): each the
+    /// same bit for bit whatever the range it is computed in.
+    fn sample_values(&self, ds: f64, from: usize, to: usize, blocks: bool) -> Vec<RailDeviation> {
+        debug_assert!(from.is_multiple_of(RESEED));
+        let mut v = Vec::with_capacity(to + 1 - from);
         let m = self.omega.len();
         let mut zr = vec![0.0; m];
         let mut zi = vec![0.0; m];
@@ -340,7 +385,7 @@ impl StochasticIrregularity {
             wr[k] = cs;
             wi[k] = sn;
         }
-        let at = |i: usize| (self.start + i as f64 * ds).min(self.end);
+        let at = |i: usize| self.sample_position(ds, i);
         let seed = |x: f64, zr: &mut [f64], zi: &mut [f64]| {
             for k in 0..m {
                 let (sn, cs) = (self.omega[k] * x + self.phase[k]).sin_cos();
@@ -348,16 +393,15 @@ impl StochasticIrregularity {
                 zi[k] = sn;
             }
         };
-        let push = |s: &mut Vec<f64>, v: &mut Vec<RailDeviation>, x: f64, signal: f64| {
+        let push = |v: &mut Vec<RailDeviation>, x: f64, signal: f64| {
             let (w, _) = self.window(x);
-            s.push(x);
             v.push(RailDeviation::from_component(self.component, w * signal));
         };
-        let mut i = 0;
+        let mut i = from;
         // Whole blocks, none reaching the end of the extent (where a
         // sample is clamped and seeded exactly).
-        while blocks && m > 0 && i + BLOCK <= n && at(i + BLOCK - 1) < self.end {
-            if i % RESEED == 0 {
+        while blocks && m > 0 && i + BLOCK - 1 <= to && at(i + BLOCK - 1) < self.end {
+            if i.is_multiple_of(RESEED) {
                 seed(at(i), &mut zr, &mut zi);
             }
             let mut sums = [0.0; BLOCK];
@@ -377,19 +421,14 @@ impl StochasticIrregularity {
                 zi[k] = r * wi[k] + im * wr[k];
             }
             for (j, &sum) in sums.iter().enumerate() {
-                push(&mut s, &mut v, at(i + j), sum);
+                push(&mut v, at(i + j), sum);
             }
             i += BLOCK;
         }
         // The rest one at a time.
-        for i in i..=n {
+        for i in i..=to {
             let x = at(i);
-            if let Some(&last) = s.last()
-                && x <= last
-            {
-                break;
-            }
-            if i % RESEED == 0 || x == self.end {
+            if i.is_multiple_of(RESEED) || x == self.end {
                 seed(x, &mut zr, &mut zi);
             }
             let mut signal = 0.0;
@@ -397,27 +436,108 @@ impl StochasticIrregularity {
                 let term = a * z;
                 signal = if k == 0 { term } else { signal + term };
             }
-            push(&mut s, &mut v, x, signal);
+            push(&mut v, x, signal);
             for k in 0..m {
                 let r = zr[k] * wr[k] - zi[k] * wi[k];
                 zi[k] = zr[k] * wi[k] + zi[k] * wr[k];
                 zr[k] = r;
             }
         }
-        MeasuredIrregularity::from_samples(s, v)
+        v
+    }
+}
+
+/// Samples between exact phasor seeds of a sampled table: the phasors
+/// z_k = exp(i(Ω_k x + φ_k)) are advanced by w_k = exp(iΩ_k ds) per sample
+/// (a complex product instead of a sin_cos) and recomputed exactly every
+/// RESEED samples, so the rounding drift stays below ~1e-13 relative.
+const RESEED: usize = 256;
+
+/// Samples summed together: each sample's sum Σ a_k Re z_k runs over k in
+/// order (the same rounding as one at a time), and BLOCK of them are
+/// independent chains of additions that the processor overlaps.
+const BLOCK: usize = 8;
+
+/// Samples per chunk of a [`SampledIrregularity`] (204.8 m at 0.05 m).
+pub const CHUNK: usize = 4096;
+
+const _: () = assert!(RESEED.is_multiple_of(BLOCK), "a block never spans a reseed");
+const _: () = assert!(CHUNK.is_multiple_of(RESEED), "a chunk starts at a seed");
+
+/// A stochastic irregularity tabulated every `ds` m
+/// ([`StochasticIrregularity::sampled_lazily`]): the table's positions at
+/// once, its values by chunks of [`CHUNK`] samples on first use (shared by
+/// threads: each chunk is computed once). Evaluates as the
+/// [`MeasuredIrregularity`] of [`StochasticIrregularity::sampled`], bit for
+/// bit.
+#[derive(Clone)]
+pub struct SampledIrregularity {
+    source: StochasticIrregularity,
+    ds: f64,
+    /// Every sample position, m, strictly increasing.
+    s: Vec<f64>,
+    /// Chunk c holds the values of samples c·CHUNK ..= (c+1)·CHUNK (the
+    /// last one shared with the next chunk), or up to the last sample.
+    chunks: Vec<OnceLock<Vec<RailDeviation>>>,
+}
+
+impl std::fmt::Debug for SampledIrregularity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SampledIrregularity")
+            .field("source", &self.source)
+            .field("ds", &self.ds)
+            .field("samples", &self.s.len())
+            .field(
+                "chunks_computed",
+                &self.chunks.iter().filter(|c| c.get().is_some()).count(),
+            )
+            .finish()
+    }
+}
+
+/// Equal when sampled from the same realization at the same step (which
+/// chunks were computed does not matter).
+impl PartialEq for SampledIrregularity {
+    fn eq(&self, other: &Self) -> bool {
+        self.source == other.source && self.ds == other.ds
+    }
+}
+
+impl SampledIrregularity {
+    /// First and last sampled position, m.
+    pub fn range(&self) -> (f64, f64) {
+        (self.s[0], self.s[self.s.len() - 1])
+    }
+
+    /// Deviation and its s-derivative (m/m) at `s`, linearly interpolated
+    /// (as [`MeasuredIrregularity`]); zero outside the sampled range.
+    pub(crate) fn eval(&self, s: f64) -> (RailDeviation, RailDeviation) {
+        let n = self.s.len();
+        if s < self.s[0] || s > self.s[n - 1] {
+            return Default::default();
+        }
+        let i = interval(&self.s, s);
+        let c = i / CHUNK;
+        let values = self.chunks[c].get_or_init(|| {
+            let to = ((c + 1) * CHUNK).min(n - 1);
+            self.source.sample_values(self.ds, c * CHUNK, to, true)
+        });
+        let j = i - c * CHUNK;
+        interpolate(s, (self.s[i], self.s[i + 1]), (&values[j], &values[j + 1]))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::irregularity::Irregularity;
 
     /// The blocked sum gives the table of the one-at-a-time sum bit for bit:
     /// an extent whose sample count is no multiple of the block, with a
     /// clamped last sample, across several reseeds, faded at both ends.
     #[test]
     fn blocked_sampling_is_bit_identical_to_one_at_a_time() {
-        for (harmonics, end) in [(37, 263.7), (1, 70.0), (600, 130.05)] {
+        for (harmonics, end) in [(37, 263.7), (1, 70.0), (600, 130.05), (20, 1000.0)] {
             let spec = StochasticSpec {
                 model: PsdModel::Fra(4),
                 component: Component::Vertical,
@@ -437,6 +557,17 @@ mod tests {
                     blocked == single,
                     "{harmonics} harmonics to {end} m, ds = {ds}"
                 );
+                // The lazy table, its chunks computed in a scattered order,
+                // interpolates as the whole table, bit for bit, inside and
+                // at the ends of the extent and outside it.
+                let lazy = Irregularity::Sampled(g.sampled_lazily(ds).unwrap());
+                let table = Irregularity::Measured(single);
+                let points = (0..3000)
+                    .map(|k| 25.0 + ((k * 7919) % 3000) as f64 / 3000.0 * (end - 20.0))
+                    .chain([30.0, end, 30.0 + ds, end - 1e-9, 30.0 + 4096.0 * ds]);
+                for x in points {
+                    assert!(table.eval(x) == lazy.eval(x), "at {x} m");
+                }
             }
         }
     }

@@ -339,7 +339,7 @@ impl IrregularitySpec {
                     fade: *fade,
                 })?;
                 match sample_step {
-                    Some(ds) => Irregularity::Measured(g.sampled(*ds)?),
+                    Some(ds) => Irregularity::Sampled(g.sampled_lazily(*ds)?),
                     None => Irregularity::Stochastic(g),
                 }
             }
