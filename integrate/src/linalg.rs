@@ -201,62 +201,124 @@ pub fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
     sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
-/// [`cholesky_kernel`] for a constant order `N` (loops of constant length,
-/// unrolled by the compiler). Each entry of L is accumulated in a register,
-/// `a_ij − l_i0 l_j0 − l_i1 l_j1 − …` with the terms of zero `l_jk` skipped,
-/// which are the operations of [`cholesky_kernel`] in the same order: the
-/// factor is the same bit for bit.
+/// [`cholesky_kernel`] for a constant order `N` ≤ 16: the loop over the
+/// columns is written out (`j` a constant in each copy of
+/// [`cholesky_column`]), so that every inner loop has a constant length
+/// and is unrolled and vectorized.
 fn cholesky_small<const N: usize>(data: &mut [f64]) -> bool {
     let Ok(a) = <&mut [[f64; N]; N]>::try_from(data.as_chunks_mut::<N>().0) else {
         return false;
     };
-    for j in 0..N {
-        let mut d = a[j][j];
-        for col_k in &a[..j] {
-            let ljk = col_k[j];
-            if ljk != 0.0 {
-                d -= ljk * ljk;
+    macro_rules! columns {
+        ($($j:literal)*) => {
+            $(if $j < N && !cholesky_column::<N>(a, $j) {
+                return false;
+            })*
+        };
+    }
+    columns!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+    true
+}
+
+/// Column `j` of [`cholesky_small`]: the operations of [`cholesky_kernel`]
+/// on that column, in the same order, with all rows i ≥ j accumulated in
+/// registers.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // ranges from the constant j: unrolled as written
+fn cholesky_column<const N: usize>(a: &mut [[f64; N]; N], j: usize) -> bool {
+    let mut acc = a[j];
+    for k in 0..j {
+        let ljk = a[k][j];
+        if ljk != 0.0 {
+            for i in j..N {
+                acc[i] -= a[k][i] * ljk;
             }
         }
-        if d.is_nan() || d <= 0.0 || d.is_infinite() {
-            return false;
-        }
-        let ljj = d.sqrt();
-        a[j][j] = ljj;
-        let inv = 1.0 / ljj;
-        for i in j + 1..N {
-            let mut s = a[j][i];
-            for col_k in &a[..j] {
-                let ljk = col_k[j];
-                if ljk != 0.0 {
-                    s -= col_k[i] * ljk;
-                }
-            }
-            a[j][i] = s * inv;
-        }
+    }
+    let d = acc[j];
+    if !is_positive_pivot(d) {
+        return false;
+    }
+    let ljj = d.sqrt();
+    a[j][j] = ljj;
+    let inv = 1.0 / ljj;
+    for i in j + 1..N {
+        a[j][i] = acc[i] * inv;
     }
     true
 }
 
+/// Whether `d` is a usable Cholesky pivot: positive and finite (false for
+/// NaN, in two comparisons).
+#[inline(always)]
+fn is_positive_pivot(d: f64) -> bool {
+    d > 0.0 && d < f64::INFINITY
+}
+
+/// Rows of a column of L accumulated together in registers by
+/// [`cholesky_kernel`] (four SSE2 or two AVX registers).
+const ROW_BLOCK: usize = 8;
+
 /// The factorization of [`cholesky_in_place`] on the column-major data of
 /// an `n × n` matrix.
+///
+/// Column j of L is `l_ij = (a_ij − Σ_{k<j} l_ik l_jk) / l_jj`, the sum
+/// taken in the order k = 0, 1, … with the terms of zero `l_jk` skipped
+/// (the structural zeros of a vehicle's block-diagonal M cost nothing). The
+/// rows i ≥ j are taken [`ROW_BLOCK`] at a time, each block accumulated in
+/// registers over all k and stored once, so that the inner loop is a
+/// vectorizable `acc[t] −= l_{i+t,k} l_jk` without a load and a store of
+/// column j per term. Every entry sees the same operations in the same
+/// order whatever the blocking, hence the same bits at every size.
 #[inline(always)]
 fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
     for j in 0..n {
         let (left, right) = data.split_at_mut(j * n);
         let col_j = &mut right[j..n];
-        // Column j of L from the columns before it (rows j..n only; the
-        // slices carry their bounds, so the inner loop has no index checks).
-        for col_k in left.chunks_exact(n) {
-            let ljk = col_k[j];
-            if ljk != 0.0 {
-                for (c, l) in col_j.iter_mut().zip(&col_k[j..]) {
-                    *c -= l * ljk;
-                }
+        let len = n - j;
+        if len >= ROW_BLOCK {
+            // Whole blocks from row j down; the rows a whole block leaves at
+            // the bottom are done as the last ROW_BLOCK rows of the column,
+            // from their original values saved here (the rows it shares
+            // with the block above get the same values again).
+            let tail = len - ROW_BLOCK;
+            let saved: [f64; ROW_BLOCK] = col_j[tail..].try_into().expect("the last block");
+            let mut start = 0;
+            while start + ROW_BLOCK <= len {
+                let block: &mut [f64; ROW_BLOCK] = (&mut col_j[start..start + ROW_BLOCK])
+                    .try_into()
+                    .expect("a block within the column");
+                *block = column_rows(left, n, j, j + start, *block);
+                start += ROW_BLOCK;
+            }
+            if start < len {
+                let block: &mut [f64; ROW_BLOCK] =
+                    (&mut col_j[tail..]).try_into().expect("the last block");
+                *block = column_rows(left, n, j, j + tail, saved);
+            }
+        } else {
+            // A short column: blocks of 4, 2 and 1 rows.
+            let mut start = 0;
+            macro_rules! rows {
+                ($b:literal) => {
+                    if len - start >= $b {
+                        let block: &mut [f64; $b] = (&mut col_j[start..start + $b])
+                            .try_into()
+                            .expect("a block within the column");
+                        *block = column_rows(left, n, j, j + start, *block);
+                        start += $b;
+                    }
+                };
+            }
+            rows!(4);
+            rows!(2);
+            if len - start == 1 {
+                let block: &mut [f64; 1] = (&mut col_j[start..]).try_into().expect("the last row");
+                *block = column_rows(left, n, j, j + start, *block);
             }
         }
         let d = col_j[0];
-        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+        if !is_positive_pivot(d) {
             return false;
         }
         let ljj = d.sqrt();
@@ -267,6 +329,32 @@ fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
         }
     }
     true
+}
+
+/// Rows `r0..r0 + B` of column `j` in [`cholesky_kernel`]: `acc` (the
+/// original entries of those rows) minus `l_ik l_jk` for the columns k < j
+/// in `left` (column-major, `n` rows each), k ascending, zero `l_jk`
+/// skipped, accumulated in registers.
+#[inline(always)]
+fn column_rows<const B: usize>(
+    left: &[f64],
+    n: usize,
+    j: usize,
+    r0: usize,
+    mut acc: [f64; B],
+) -> [f64; B] {
+    for col_k in left.chunks_exact(n) {
+        let ljk = col_k[j];
+        if ljk != 0.0 {
+            let src: &[f64; B] = col_k[r0..r0 + B]
+                .try_into()
+                .expect("rows within the column");
+            for (a, l) in acc.iter_mut().zip(src) {
+                *a -= l * ljk;
+            }
+        }
+    }
+    acc
 }
 
 /// Solves L Lᵀ x = b in place with the factor of [`cholesky_in_place`].
@@ -287,32 +375,46 @@ pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     sized!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
-/// [`cholesky_solve_kernel`] for a constant order `N` (loops of constant
-/// length, unrolled; the same operations in the same order).
+/// [`cholesky_solve_kernel`] for a constant order `N` ≤ 16, the loops over
+/// the columns written out (the same operations in the same order).
+#[allow(clippy::needless_range_loop)] // ranges from the constant j: unrolled as written
 fn cholesky_solve_small<const N: usize>(data: &[f64], b: &mut [f64]) {
-    let (cols, _) = data.as_chunks::<N>();
-    for j in 0..N {
-        let col = &cols[j];
-        let yj = b[j] / col[j];
-        b[j] = yj;
-        if yj != 0.0 {
-            for i in 0..N {
-                if i > j {
-                    b[i] -= col[i] * yj;
+    let (Ok(l), Ok(x)) = (
+        <&[[f64; N]; N]>::try_from(data.as_chunks::<N>().0),
+        <&mut [f64; N]>::try_from(b),
+    ) else {
+        return;
+    };
+    // L y = b, column j: y_j, then subtract it from the rows below.
+    macro_rules! forward {
+        ($($j:literal)*) => {
+            $(if $j < N {
+                let col = &l[$j];
+                let yj = x[$j] / col[$j];
+                x[$j] = yj;
+                if yj != 0.0 {
+                    for i in $j + 1..N {
+                        x[i] -= col[i] * yj;
+                    }
                 }
-            }
-        }
+            })*
+        };
     }
-    for j in (0..N).rev() {
-        let col = &cols[j];
-        let mut s = b[j];
-        for i in 0..N {
-            if i > j {
-                s -= col[i] * b[i];
-            }
-        }
-        b[j] = s / col[j];
+    forward!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+    // Lᵀ x = y, row j: a dot product down column j, from the last row up.
+    macro_rules! backward {
+        ($($j:literal)*) => {
+            $(if $j < N {
+                let col = &l[$j];
+                let mut s = x[$j];
+                for i in $j + 1..N {
+                    s -= col[i] * x[i];
+                }
+                x[$j] = s / col[$j];
+            })*
+        };
     }
+    backward!(15 14 13 12 11 10 9 8 7 6 5 4 3 2 1 0);
 }
 
 /// The solve of [`cholesky_solve`] with the factor's column-major data
@@ -339,6 +441,36 @@ fn cholesky_solve_kernel(data: &[f64], b: &mut [f64], n: usize) {
         }
         head[j] = s / col[j];
     }
+}
+
+/// The factorization and solve as they were before the row blocking (one
+/// load and store of column j per term), the reference the tests compare
+/// the blocked kernel with bit for bit.
+#[cfg(test)]
+fn cholesky_reference(data: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let (left, right) = data.split_at_mut(j * n);
+        let col_j = &mut right[j..n];
+        for col_k in left.chunks_exact(n) {
+            let ljk = col_k[j];
+            if ljk != 0.0 {
+                for (c, l) in col_j.iter_mut().zip(&col_k[j..]) {
+                    *c -= l * ljk;
+                }
+            }
+        }
+        let d = col_j[0];
+        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+            return false;
+        }
+        let ljj = d.sqrt();
+        col_j[0] = ljj;
+        let inv = 1.0 / ljj;
+        for x in &mut col_j[1..] {
+            *x *= inv;
+        }
+    }
+    true
 }
 
 #[cfg(test)]
@@ -379,28 +511,41 @@ mod cholesky_tests {
     }
 
     #[test]
-    fn sized_kernels_round_exactly_like_the_general_ones() {
-        // The unrolled kernels of orders ≤ 16 must give the general kernel's
-        // factor and solution bit for bit (the scenario outputs must not
-        // depend on which one ran).
-        for n in 1usize..=16 {
+    fn blocked_kernels_round_exactly_like_the_unblocked_reference() {
+        // The row-blocked factorization (sized copies for orders ≤ 16, the
+        // general one above) must give the unblocked reference's factor and
+        // solution bit for bit (the scenario outputs must not depend on the
+        // blocking); orders up to 40 cover whole blocks, remainders and both
+        // paths. Every third matrix has structural zeros (two uncoupled
+        // diagonal blocks, as in a vehicle's M), which both skip.
+        for n in 1usize..=40 {
             let b = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 11) % 13) as f64 / 7.0 - 0.8);
-            let a = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
-            let mut small = a.clone();
-            let mut general = a.clone();
-            assert!(cholesky_in_place(&mut small));
-            assert!(cholesky_kernel(general.as_mut_slice(), n));
+            let mut a = &b * b.transpose() + DMatrix::identity(n, n) * 0.1;
+            if n % 3 == 0 {
+                let h = n / 2;
+                for i in 0..n {
+                    for j in 0..n {
+                        if (i < h) != (j < h) {
+                            a[(i, j)] = 0.0;
+                        }
+                    }
+                }
+            }
+            let mut blocked = a.clone();
+            let mut reference = a.clone();
+            assert!(cholesky_in_place(&mut blocked));
+            assert!(cholesky_reference(reference.as_mut_slice(), n));
             let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.91).cos()).collect();
             let mut xs = rhs.clone();
             let mut xg = rhs.clone();
-            cholesky_solve(&small, &mut xs);
-            cholesky_solve_kernel(general.as_slice(), &mut xg, n);
+            cholesky_solve(&blocked, &mut xs);
+            cholesky_solve_kernel(reference.as_slice(), &mut xg, n);
             for j in 0..n {
                 for i in j..n {
                     assert_eq!(
-                        small[(i, j)].to_bits(),
-                        general[(i, j)].to_bits(),
-                        "n = {n}"
+                        blocked[(i, j)].to_bits(),
+                        reference[(i, j)].to_bits(),
+                        "n = {n}, entry ({i}, {j})"
                     );
                 }
             }

@@ -56,13 +56,13 @@ fn acceleration<S: MechanicalSystem + ?Sized>(
     // searched for the culprit only then, so the common path pays nothing.
     if cholesky_in_place(mass) {
         cholesky_solve(mass, accel.as_mut_slice());
-        if accel.iter().all(|x| x.is_finite()) {
+        if crate::all_finite(accel.as_slice()) {
             return Ok(());
         }
     }
     check_finite(t, "force f", accel.as_slice())?;
     check_finite(t, "mass matrix M", mass.as_slice())?;
-    if accel.iter().all(|x| x.is_finite()) {
+    if crate::all_finite(accel.as_slice()) {
         Err(SimError::Diverged {
             t,
             reason:
@@ -231,32 +231,41 @@ impl<S: MechanicalSystem> Rk4<S> {
         let t_new = if tk >= t_end - 1e-6 * h { t_end } else { tk };
         let hs = t_new - t;
         let half = 0.5 * hs;
-        let (q, v, st) = (&self.q, &self.v, &mut self.stats);
+        let (q, v, st) = (self.q.as_slice(), self.v.as_slice(), &mut self.stats);
         let (qs, mass, sys) = (&mut self.qs, &mut self.mass, &mut self.system);
+        // One pass per stage state, `y + c·k` without temporaries (the same
+        // rounding as `copy` then `axpy`: c·k + y).
+        let stage =
+            |qs: &mut DVector<f64>, vs: &mut DVector<f64>, c: f64, dq: &[f64], dv: &[f64]| {
+                add_scaled(qs.as_mut_slice(), q, c, dq);
+                add_scaled(vs.as_mut_slice(), v, c, dv);
+            };
         // Stage 2: y + h/2 k1.
-        qs.copy_from(q);
-        qs.axpy(half, v, 1.0);
-        self.v2.copy_from(v);
-        self.v2.axpy(half, &self.a1, 1.0);
+        stage(qs, &mut self.v2, half, v, self.a1.as_slice());
         acceleration(sys, t + half, qs, &self.v2, mass, &mut self.a2, st)?;
         // Stage 3: y + h/2 k2.
-        qs.copy_from(q);
-        qs.axpy(half, &self.v2, 1.0);
-        self.v3.copy_from(v);
-        self.v3.axpy(half, &self.a2, 1.0);
+        stage(
+            qs,
+            &mut self.v3,
+            half,
+            self.v2.as_slice(),
+            self.a2.as_slice(),
+        );
         acceleration(sys, t + half, qs, &self.v3, mass, &mut self.a3, st)?;
         // Stage 4: y + h k3.
-        qs.copy_from(q);
-        qs.axpy(hs, &self.v3, 1.0);
-        self.v4.copy_from(v);
-        self.v4.axpy(hs, &self.a3, 1.0);
+        stage(qs, &mut self.v4, hs, self.v3.as_slice(), self.a3.as_slice());
         acceleration(sys, t_new, qs, &self.v4, mass, &mut self.a4, st)?;
         // y₊ = y + h/6 (k1 + 2k2 + 2k3 + k4).
         let w = hs / 6.0;
-        for i in 0..self.q.len() {
-            self.q[i] += w * (self.v[i] + 2.0 * self.v2[i] + 2.0 * self.v3[i] + self.v4[i]);
-            self.v[i] += w * (self.a1[i] + 2.0 * self.a2[i] + 2.0 * self.a3[i] + self.a4[i]);
-        }
+        let (v2, v3, v4) = (self.v2.as_slice(), self.v3.as_slice(), self.v4.as_slice());
+        let (a1, a2, a3, a4) = (
+            self.a1.as_slice(),
+            self.a2.as_slice(),
+            self.a3.as_slice(),
+            self.a4.as_slice(),
+        );
+        rk4_combine(self.q.as_mut_slice(), w, [self.v.as_slice(), v2, v3, v4]);
+        rk4_combine(self.v.as_mut_slice(), w, [a1, a2, a3, a4]);
         self.t = t_new;
         self.h_last = hs;
         check_finite(t_new, "coordinate q", self.q.as_slice())?;
@@ -301,6 +310,25 @@ impl<S: MechanicalSystem> Rk4<S> {
         self.stats.v.copy_from(&self.v);
         self.stats.accel.copy_from(&self.a1);
         Ok(self.state())
+    }
+}
+
+/// `out = y + c·k`, entry by entry. Not inlined: [`Rk4`] is generic and
+/// compiled in the crate that names its system, at that crate's
+/// optimization level; this loop stays compiled here.
+#[inline(never)]
+fn add_scaled(out: &mut [f64], y: &[f64], c: f64, k: &[f64]) {
+    for ((o, y), k) in out.iter_mut().zip(y).zip(k) {
+        *o = y + c * k;
+    }
+}
+
+/// `y += w (k1 + 2 k2 + 2 k3 + k4)`, entry by entry (the classical RK4
+/// update with w = h/6). Not inlined, as [`add_scaled`].
+#[inline(never)]
+fn rk4_combine(y: &mut [f64], w: f64, [k1, k2, k3, k4]: [&[f64]; 4]) {
+    for ((((y, k1), k2), k3), k4) in y.iter_mut().zip(k1).zip(k2).zip(k3).zip(k4) {
+        *y += w * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
     }
 }
 

@@ -306,7 +306,7 @@ impl ModelSystem {
     /// state residuals in the rows after them.
     fn applied_forces(&mut self, t: f64, out: &mut DVector<f64>) -> Result<(), SimError> {
         let n = self.n_coordinates;
-        out.rows_mut(0, n).copy_from(&self.eval.gravity);
+        out.as_mut_slice()[..n].copy_from_slice(self.eval.gravity.as_slice());
         if self.forces.is_empty() {
             return Ok(());
         }
@@ -364,10 +364,17 @@ impl MechanicalSystem for ModelSystem {
             .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
         self.applied_forces(t, force)?;
         let n = self.n_coordinates;
-        let mut top = force.rows_mut(0, n);
-        top -= &self.eval.bias;
+        // Slices, not nalgebra's generic views: a plain loop and a memcpy
+        // at any optimization level (this runs once per RK4 stage).
+        for (f, b) in force.as_mut_slice()[..n]
+            .iter_mut()
+            .zip(self.eval.bias.as_slice())
+        {
+            *f -= b;
+        }
         if self.states.is_empty() {
-            mass.copy_from(&self.eval.mass);
+            mass.as_mut_slice()
+                .copy_from_slice(self.eval.mass.as_slice());
         } else {
             // Element states have no inertia: zero rows and columns.
             mass.as_mut_slice().fill(0.0);
