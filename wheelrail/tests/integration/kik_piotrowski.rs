@@ -22,6 +22,7 @@ fn quadratic_gap(b: f64, r: f64, half_width: f64, dy: f64) -> Vec<GapSample> {
             GapSample {
                 wheel_u: y,
                 rail_y: y,
+                rail_z: 0.0,
                 gap: b * y * y,
                 rolling_radius: r,
                 contact_angle: 0.0,
