@@ -18,7 +18,13 @@ use railmbs_wheelrail::profile::{Profile, ProfileKind, ProfileSettings};
 /// and wheel profile `wheel`, rail profile `rail` (files under
 /// models/profiles).
 fn model_text(contact: &str, wheel: &str, rail: &str) -> String {
-    let profile = |f: &str| model_path(&format!("profiles/{f}")).display().to_string();
+    let profile = |f: &str| {
+        if f.starts_with('/') {
+            f.to_string()
+        } else {
+            model_path(&format!("profiles/{f}")).display().to_string()
+        }
+    };
     format!(
         r#"Model(
     name: "wheelset_on_springs_kp",
@@ -306,3 +312,113 @@ fn flange_states_match_the_standalone_patches() {
     assert!(counts.contains(&2), "two-point contact: patch counts {counts:?}");
 }
 
+
+/// (a) Constant curvatures: the 1:20 cone (models/profiles/cone_1in20.dat,
+/// no transverse curvature) on a rail head that is one circular arc of
+/// radius 300 mm, centred wheelset in its rolling equilibrium (μ = 0.4,
+/// 30 m/s), Kik–Piotrowski against Hertz with the strip law (the same strip
+/// solution on the Hertz ellipse: what differs is the patch only).
+///
+/// - **Normal force:** the wheel load the same (statics) to 1e-6, the
+///   normal force to 2e-4 (the contact angle and the spin force's vertical
+///   part, in the test).
+/// - **Patch area** against Hertz's analytic ellipse for the curvatures
+///   (A = cos γ/(2r), B = 1/(2R)): within 12 %, the standalone method's
+///   bound for B/A from 0.2 to 5 (here B/A = 1.53; KP's patch has the axis
+///   ratio √(A/B) of the virtual-penetration ellipse, not Hertz's).
+/// - **Creep forces** at a lateral creepage η from a lateral velocity: in
+///   the linear range (η = 1e-4) the force is G·area·C22 η with Kalker's C22
+///   of each patch's (equivalent) ellipse, so it follows the area and the
+///   axis ratio: within 15 % (the 12 % of the area plus C22's change with
+///   a/b, which is slow: 3 % between a/b = 0.8 and 1.2); at full sliding
+///   (η = 0.03, |s| > 1 on every strip) both are μN along the slip: within
+///   1 % (the 10-strip law's quadrature error is 1e-4, KP's strip sum is
+///   exact).
+#[test]
+fn constant_curvatures_agree_with_hertz() {
+    use railmbs_wheelrail::hertz::HertzShape;
+    let dir = tempfile::tempdir().unwrap();
+    let radius = 0.3_f64;
+    let rail = dir.path().join("arc_r300.dat");
+    // Gauge side of u = −25 mm: the arc falls away by a further
+    // 1.3e4 (u + 25 mm)³ (smooth to the second derivative, 14 mm deep at
+    // −34 mm), a gauge face for the track's gauge, far from the contact.
+    let mut text = String::from("# circular rail head, R = 300 mm (y z, mm)\n");
+    for i in -80..=70 {
+        let u = i as f64 * 0.5e-3;
+        let fall = (-25e-3 - u).max(0.0);
+        let z = -(radius - (radius * radius - u * u).sqrt()) - 1.3e4 * fall.powi(3);
+        text.push_str(&format!("{} {}\n", u * 1e3, z * 1e3));
+    }
+    std::fs::write(&rail, text).unwrap();
+    let rail = rail.display().to_string();
+    // kz = 0: the springs carry their preload alone, whatever the height.
+    let params = r#""y0": 0.0, "dz0": 2e-4, "kz": 0.0"#;
+    // With the 1:20 cone the contact lies 15 mm to the field side of the
+    // crown, inside the arc (−25…35 mm).
+    let mut solved = Vec::new();
+    for contact in [HERTZ_STRIP, KP] {
+        let (scenario, model) = case(
+            dir.path(),
+            &model_text(contact, "cone_1in20.dat", &rail),
+            params,
+            0.01,
+            true,
+        );
+        let s = scenario_system(&scenario, &model, Box::new(NumericEquations::new(&model)))
+            .unwrap_or_else(|e| panic!("{contact}: {e}"));
+        solved.push(s);
+    }
+    let iy = coordinate(&solved[0], "ws.y");
+    let mut at = Vec::new();
+    for eta in [0.0, 1e-4, 0.03] {
+        let mut row = Vec::new();
+        for s in &mut solved {
+            let eq = s.equilibrium.clone().unwrap();
+            let mut v = eq.v.clone();
+            v[iy] += eta * 30.0;
+            row.push(element_outputs(&mut s.system, 0.0, &eq.q, &v));
+        }
+        at.push(row);
+    }
+    let (h, k) = (&at[0][0], &at[0][1]);
+    let n = h["L.N [N]"];
+    println!(
+        "N {n:.2} / {:.2} N, angle {:.5} / {:.5}, radius {:.5}, KP area {:.4e}",
+        k["L.N [N]"],
+        h["L.contact_angle [rad]"],
+        k["L.contact_angle [rad]"],
+        h["L.rolling_radius [m]"],
+        k["L.patch_area [m2]"]
+    );
+    assert_eq!((h["L.contacts [-]"], k["L.contacts [-]"]), (1.0, 1.0));
+    // Statics fix the vertical load Q = N cos γ + Fy sin γ (the spin's
+    // lateral creep force has a vertical part); KP's contact angle is its
+    // deepest sample's, within the sampling step over the rail radius
+    // (0.1 mm / 300 mm = 3.3e-4 rad) of the exact one (cos γ within 1.7e-5),
+    // and the spin's Fy differs with the patch (below), which moves N by
+    // ΔFy tan γ: 2e-4 of N allows ΔFy up to 200 N.
+    assert!((k["L.Q [N]"] / h["L.Q [N]"] - 1.0).abs() < 1e-6);
+    assert!((k["L.N [N]"] / n - 1.0).abs() < 2e-4);
+    let (gamma, r) = (h["L.contact_angle [rad]"], h["L.rolling_radius [m]"]);
+    let shape = HertzShape::new(gamma.cos() / (2.0 * r), 0.5 / radius, 2.1e11, 0.28).unwrap();
+    let e = shape.contact(n).unwrap();
+    let hertz_area = std::f64::consts::PI * e.a * e.b;
+    let area_err = k["L.patch_area [m2]"] / hertz_area - 1.0;
+    println!("area: KP against Hertz {area_err:+.4}");
+    assert!(area_err.abs() < 0.12, "area {area_err}");
+    for (i, tol) in [(1, 0.15), (2, 0.01)] {
+        let (h, k) = (&at[i][0], &at[i][1]);
+        let (fh, fk) = (h["L.Fy [N]"] - at[0][0]["L.Fy [N]"], k["L.Fy [N]"] - at[0][1]["L.Fy [N]"]);
+        let (fh_all, fk_all) = (h["L.Fy [N]"], k["L.Fy [N]"]);
+        println!(
+            "eta case {i}: Fy Hertz {fh_all:.2} KP {fk_all:.2} (less the spin's: {fh:.2} {fk:.2}), \
+             Fx {:.2} {:.2}, mu N {:.1}",
+            h["L.Fx [N]"],
+            k["L.Fx [N]"],
+            0.4 * n
+        );
+        let err = if i == 1 { fk / fh - 1.0 } else { fk_all / fh_all - 1.0 };
+        assert!(err.abs() < tol, "case {i}: Fy {err}");
+    }
+}
