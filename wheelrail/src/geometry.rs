@@ -782,8 +782,8 @@ impl ContactGeometry {
     /// least `max_gap` (included, so that every run of interpenetration is
     /// whole and bounded), in the order of the wheel coordinate; empty where
     /// nothing comes that close. For a contact model that needs only the
-    /// patches (each a few mm of a 140 mm profile) this is about a tenth of
-    /// the work of the whole profile.
+    /// patches (each a few mm of a 140 mm profile) this takes about half the
+    /// time of the whole profile (the coarse pass is most of it).
     ///
     /// A first pass samples every [`GAP_SCAN_STRIDE`]th point of the grid
     /// and keeps the cells next to those whose gap is below

@@ -5,9 +5,9 @@
 //! here with a lateral offset `yc` of its axlebox springs and the contact
 //! model to choose.
 
-use railmbs_models::{InitialStateKind, Model, Scenario, load_model, load_scenario};
+use railmbs_models::{Model, Scenario, load_model, load_scenario};
+use railmbs_runtime::NumericEquations;
 use railmbs_runtime::run::scenario::scenario_system;
-use railmbs_runtime::{Equations, NumericEquations};
 use railmbs_testkit::*;
 use railmbs_wheelrail::geometry::{ContactGeometry, SearchSettings, Track, Wheelset};
 use railmbs_wheelrail::kik_piotrowski::KikPiotrowski;
@@ -71,8 +71,6 @@ fn s1002(contact: &str) -> String {
 
 const KP: &str = "contact: KikPiotrowski()";
 const HERTZ_STRIP: &str = "creep: Strip(strips: 10)";
-#[allow(unused_imports)]
-use railmbs_runtime::Parts;
 
 /// The scenario (straight track from s = 10 m at 30 m/s, Park, outputs every
 /// 2 ms) for the model text `model` with `parameters` (RON map entries),
@@ -108,7 +106,6 @@ fn case(
     let model = load_model(&scenario.model).unwrap_or_else(|e| panic!("{e}"));
     (scenario, model)
 }
-
 
 /// The element's outputs by column name at a state of `sys` (after
 /// evaluating it there).
@@ -233,7 +230,10 @@ fn static_sweep_balances_the_axle_load_and_matches_the_standalone_patches() {
             out["L.patch_area [m2]"] * 1e6,
             out["R.patch_area [m2]"] * 1e6
         );
-        assert!(balance.abs() < 1e-6, "yc = {yc}: axle load balance {balance}");
+        assert!(
+            balance.abs() < 1e-6,
+            "yc = {yc}: axle load balance {balance}"
+        );
         for (side, name) in [(0, "L"), (1, "R")] {
             let q = out[&format!("{name}.Q [N]")];
             let samples = geo.gap_samples(side, y, roll, 1e-4).unwrap();
@@ -301,7 +301,11 @@ fn flange_states_match_the_standalone_patches() {
             out["L.patch_area [m2]"]
         );
         assert_eq!(out["L.contacts [-]"], patches.len() as f64, "y = {y}");
-        assert!((out["L.Q [N]"] / 6e4 - 1.0).abs() < 1e-6, "y = {y}: Q {}", out["L.Q [N]"]);
+        assert!(
+            (out["L.Q [N]"] / 6e4 - 1.0).abs() < 1e-6,
+            "y = {y}: Q {}",
+            out["L.Q [N]"]
+        );
         assert!(
             (out["L.patch_area [m2]"] / area - 1.0).abs() < 1e-6,
             "y = {y}: area {} against {area}",
@@ -309,9 +313,11 @@ fn flange_states_match_the_standalone_patches() {
         );
         counts.push(patches.len());
     }
-    assert!(counts.contains(&2), "two-point contact: patch counts {counts:?}");
+    assert!(
+        counts.contains(&2),
+        "two-point contact: patch counts {counts:?}"
+    );
 }
-
 
 /// (a) Constant curvatures: the 1:20 cone (models/profiles/cone_1in20.dat,
 /// no transverse curvature) on a rail head that is one circular arc of
@@ -409,7 +415,10 @@ fn constant_curvatures_agree_with_hertz() {
     assert!(area_err.abs() < 0.12, "area {area_err}");
     for (i, tol) in [(1, 0.15), (2, 0.01)] {
         let (h, k) = (&at[i][0], &at[i][1]);
-        let (fh, fk) = (h["L.Fy [N]"] - at[0][0]["L.Fy [N]"], k["L.Fy [N]"] - at[0][1]["L.Fy [N]"]);
+        let (fh, fk) = (
+            h["L.Fy [N]"] - at[0][0]["L.Fy [N]"],
+            k["L.Fy [N]"] - at[0][1]["L.Fy [N]"],
+        );
         let (fh_all, fk_all) = (h["L.Fy [N]"], k["L.Fy [N]"]);
         println!(
             "eta case {i}: Fy Hertz {fh_all:.2} KP {fk_all:.2} (less the spin's: {fh:.2} {fk:.2}), \
@@ -418,7 +427,11 @@ fn constant_curvatures_agree_with_hertz() {
             k["L.Fx [N]"],
             0.4 * n
         );
-        let err = if i == 1 { fk / fh - 1.0 } else { fk_all / fh_all - 1.0 };
+        let err = if i == 1 {
+            fk / fh - 1.0
+        } else {
+            fk_all / fh_all - 1.0
+        };
         assert!(err.abs() < tol, "case {i}: Fy {err}");
     }
 }
@@ -451,13 +464,20 @@ fn wheelset_run_with_both_engines() {
     let (hs, hm) = case(dir.path(), &s1002(HERTZ_STRIP), "", 0.5, false);
     let t0 = std::time::Instant::now();
     let hertz = run_to_table(&hs, &hm, Box::new(NumericEquations::new(&hm)));
-    println!("wall time (numeric, 0.5 s): KP {kp_time:?}, Hertz {:?}", t0.elapsed());
+    println!(
+        "wall time (numeric, 0.5 s): KP {kp_time:?}, Hertz {:?}",
+        t0.elapsed()
+    );
     // Finite, N ≥ 0.
     for row in &num.rows {
         assert!(row.iter().all(|x| x.is_finite()), "not finite: {row:?}");
     }
     for side in ["L", "R"] {
-        assert!(num.col(&format!("contact.{side}.N [N]")).iter().all(|&n| n >= 0.0));
+        assert!(
+            num.col(&format!("contact.{side}.N [N]"))
+                .iter()
+                .all(|&n| n >= 0.0)
+        );
     }
     let time = num.col("time");
     let mp = model.default_parameter_values();
@@ -468,7 +488,10 @@ fn wheelset_run_with_both_engines() {
     let late: Vec<usize> = (0..time.len()).filter(|&i| time[i] >= 0.25).collect();
     let mean = late.iter().map(|&i| ql[i] + qr[i]).sum::<f64>() / late.len() as f64;
     println!("mean axle load over 0.25–0.5 s: {mean:.1} N against {axle:.1} N");
-    assert!((mean / axle - 1.0).abs() < 0.01, "axle load {mean} against {axle}");
+    assert!(
+        (mean / axle - 1.0).abs() < 0.01,
+        "axle load {mean} against {axle}"
+    );
     let (y, ys, yh) = (num.col("ws.y[m]"), sym.col("ws.y[m]"), hertz.col("ws.y[m]"));
     assert_eq!(y.len(), ys.len());
     assert_eq!(y.len(), yh.len());
@@ -478,11 +501,15 @@ fn wheelset_run_with_both_engines() {
         worst.0 = worst.0.max((y[i] - ys[i]).abs());
         worst.1 = worst.1.max((y[i] - yh[i]).abs());
     }
-    println!("largest |y| differences: engines {:.2e} m, against Hertz {:.2e} m", worst.0, worst.1);
+    println!(
+        "largest |y| differences: engines {:.2e} m, against Hertz {:.2e} m",
+        worst.0, worst.1
+    );
     assert!(worst.0 < 1e-6, "engines differ by {} m", worst.0);
     assert!(worst.1 < 5e-4, "KP and Hertz differ by {} m", worst.1);
     // M and f of both engines at the start and along the run.
-    let mut a = scenario_system(&scenario, &model, Box::new(NumericEquations::new(&model))).unwrap();
+    let mut a =
+        scenario_system(&scenario, &model, Box::new(NumericEquations::new(&model))).unwrap();
     let mut b = scenario_system(&scenario, &model, Box::new(symbolic_engine(&model))).unwrap();
     // The start, and the start moved by set offsets: lateral, on the flange
     // (8 mm), sunk, yawed, rolled, with lateral and yaw rates.
@@ -508,7 +535,10 @@ fn wheelset_run_with_both_engines() {
         let dm = (&ma - &mb).abs().max() / ma.abs().max();
         let df = (&fa - &fb).abs().max() / fa.abs().max();
         println!("t {t}: M {dm:.1e}, f {df:.1e}, |f| {:.3e}", fa.abs().max());
-        assert!(dm < 1e-12 && df < 1e-12, "engines differ at t = {t}: M {dm}, f {df}");
+        assert!(
+            dm < 1e-12 && df < 1e-12,
+            "engines differ at t = {t}: M {dm}, f {df}"
+        );
     }
 }
 
@@ -524,19 +554,36 @@ fn bad_kik_piotrowski_input_is_a_located_error() {
         load_model(&path).map(|_| ()).unwrap_err().to_string()
     };
     for (contact, what) in [
-        ("contact: KikPiotrowski(penetration_reduction: 1.5)", "penetration_reduction must be in (0, 1], got 1.5"),
-        ("contact: KikPiotrowski(penetration_reduction: 0)", "penetration_reduction must be in (0, 1], got 0"),
-        ("contact: KikPiotrowski(strip_width: 0.01)", "strip_width must be in (0, 1e-3] m"),
-        ("contact: KikPiotrowski(), creep: Kalker", "`creep` is not used with `contact: KikPiotrowski(..)`"),
+        (
+            "contact: KikPiotrowski(penetration_reduction: 1.5)",
+            "penetration_reduction must be in (0, 1], got 1.5",
+        ),
+        (
+            "contact: KikPiotrowski(penetration_reduction: 0)",
+            "penetration_reduction must be in (0, 1], got 0",
+        ),
+        (
+            "contact: KikPiotrowski(strip_width: 0.01)",
+            "strip_width must be in (0, 1e-3] m",
+        ),
+        (
+            "contact: KikPiotrowski(), creep: Kalker",
+            "`creep` is not used with `contact: KikPiotrowski(..)`",
+        ),
     ] {
         let e = load(contact);
         println!("{e}");
-        assert!(e.contains("bad.ron:") && e.contains("\"contact\"") && e.contains(what), "{e}");
+        assert!(
+            e.contains("bad.ron:") && e.contains("\"contact\"") && e.contains(what),
+            "{e}"
+        );
     }
     // Through a parameter: the model loads (ε = 0.5 there), the run's value
     // is refused when the element gets its parameters.
-    let text = s1002("contact: KikPiotrowski(penetration_reduction: \"eps\")")
-        .replace("\"cn\": (value: 2e5),", "\"cn\": (value: 2e5), \"eps\": (value: 0.5),");
+    let text = s1002("contact: KikPiotrowski(penetration_reduction: \"eps\")").replace(
+        "\"cn\": (value: 2e5),",
+        "\"cn\": (value: 2e5), \"eps\": (value: 0.5),",
+    );
     std::fs::write(dir.path().join("model.ron"), &text).unwrap();
     let (mut scenario, model) = case(dir.path(), &text, r#""eps": 0.5"#, 0.01, false);
     scenario.set_parameter("eps", "-0.2");
@@ -546,7 +593,8 @@ fn bad_kik_piotrowski_input_is_a_located_error() {
     };
     println!("{e}");
     assert!(
-        e.contains("wheel–rail element \"contact\"") && e.contains("penetration_reduction must be in (0, 1], got -0.2"),
+        e.contains("wheel–rail element \"contact\"")
+            && e.contains("penetration_reduction must be in (0, 1], got -0.2"),
         "{e}"
     );
 }

@@ -243,7 +243,8 @@ impl WheelRailContact {
         if penetration <= 0.0 || weight == 0.0 {
             return Ok(None);
         }
-        let cd = c.contact_angle.cos();
+        // (the cosine as `point_kinematics` takes it, bit for bit)
+        let (_, cd) = c.contact_angle.sin_cos();
         // N ∝ approach^{3/2}: the load scales by `weight`.
         let approach = penetration * weight.powf(2.0 / 3.0) * cd;
         // Hertz shape from the curvatures at the contact.
