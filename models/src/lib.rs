@@ -302,6 +302,9 @@
 //!           // or MuellerKalkerSaturated(exponent: 2)   Kalker's linear force saturated towards μN
 //!           // or Polach(ka: 1.0, ks: 1.0, friction_decrease: (0.4, 0.6))   (A, B s/m), optional
 //!           // (railmbs_wheelrail::creep::CreepLawSpec; its real settings may be expressions)
+//!           contact: Hertz,                   // default: elliptic patches, forces by `creep`
+//!           // or KikPiotrowski(penetration_reduction: 0.55, strip_width: 1e-4)   (–, m) non-elliptic
+//!           //     patches, several per wheel, tangential forces by strips (then no `creep`)
 //!           rail: Rigid,                      // or Elastic(ky: .., cy: .., kz: .., cz: ..)  N/m, N s/m
 //!           // Elastic(.., lateral_damping: Always)   cy in every contact mode (default), or
 //!           //     TwoPointContact: in two-point contact only (Pogorelov 2005, Sect. 4.2)

@@ -8,7 +8,9 @@
 //! transformations from the parent's body frame to the child's body frame.
 
 use crate::expr::Expr;
-pub use crate::forces::{ContactTableSpec, ForceKind, ProfileFile, RailKind, WheelRail};
+pub use crate::forces::{
+    ContactModel, ContactTableSpec, ForceKind, ProfileFile, RailKind, WheelRail,
+};
 pub use railmbs_wheelrail::creep::{CreepLawSpec, SlidingZone};
 use std::path::PathBuf;
 

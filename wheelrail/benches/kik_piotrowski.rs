@@ -59,6 +59,26 @@ fn bench(c: &mut Criterion) {
                 )
             })
         });
+        // What the wheel–rail element does per wheel and evaluation: the gap
+        // near the patches at the approach, the patches, their creep forces.
+        c.bench_function(&format!("kp_wheel_in_element_{name}"), |b| {
+            b.iter(|| {
+                let s = geo
+                    .gap_samples_below(0, black_box(y), 0.0, 0.1e-3, approach)
+                    .unwrap();
+                for p in kp.patches(&s, approach).unwrap() {
+                    black_box(p.creep_forces(g, kp.poisson, 0.3, &creep).unwrap());
+                }
+            })
+        });
+        c.bench_function(&format!("kp_gap_samples_below_0.1mm_{name}"), |b| {
+            b.iter(|| {
+                black_box(
+                    geo.gap_samples_below(0, black_box(y), 0.0, 0.1e-3, approach)
+                        .unwrap(),
+                )
+            })
+        });
         c.bench_function(&format!("kp_creep_forces_{name}"), |b| {
             b.iter(|| {
                 for p in &patches {

@@ -155,6 +155,9 @@ pub struct Patch {
     /// Reference point (the deepest sample): lateral position of the rail point in the
     /// track frame (m).
     pub rail_y: f64,
+    /// Height of the rail point of the reference point (m, rail profile
+    /// convention, as [`crate::geometry::Contact::rail_z`]).
+    pub rail_z: f64,
     /// Wheel profile coordinate of the reference point (m).
     pub wheel_u: f64,
     /// Contact angle at the reference point (rad).
@@ -392,6 +395,7 @@ impl KikPiotrowski {
         Some(Patch {
             strips,
             rail_y: r.rail_y,
+            rail_z: r.rail_z,
             wheel_u: r.wheel_u,
             contact_angle: r.contact_angle,
             rolling_radius: r.rolling_radius,

@@ -20,7 +20,7 @@ use std::sync::Arc;
 /// the axle centre and its y axis along the axle (to the left); its spin
 /// about y may be a coordinate or not (then the wheels' rolling speed is
 /// that of the body's angular velocity anyway).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct WheelRail {
     /// The wheelset body.
     pub wheelset: usize,
@@ -49,8 +49,11 @@ pub struct WheelRail {
     pub poisson: Expr,
     /// Damping along the contact normal, N s/m (0: none).
     pub normal_damping: Expr,
-    /// The creep-force law and its settings (expressions over parameters).
+    /// The creep-force law and its settings (expressions over parameters);
+    /// used by the Hertz contact only (see [`ContactModel`]).
     pub creep: CreepLawSpec<Expr>,
+    /// The contact model: Hertz (default) or non-elliptic Kik–Piotrowski.
+    pub contact: ContactModel,
     /// Rigid rails, or massless elastic rails (Pogorelov 2005, Sect. 4.2).
     pub rail: RailKind,
     /// Contact table ranges and steps.
@@ -62,6 +65,57 @@ pub struct WheelRail {
     /// still follows the `wheelset` (axle) body's pose. `None`: a solid
     /// wheelset, both wheels on the `wheelset` body.
     pub wheels: Option<[usize; 2]>,
+}
+
+/// The field list of the derived form, with `contact` only where it is not
+/// the default Hertz: the model's structural text
+/// ([`crate::Model::canonical_structure`], the compiled plugin's key) of the
+/// models written before the contact model could be chosen stays the same
+/// (the plugin does not depend on it: the runtime evaluates the contact).
+impl std::fmt::Debug for WheelRail {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("WheelRail");
+        d.field("wheelset", &self.wheelset)
+            .field("wheel_profiles", &self.wheel_profiles)
+            .field("rail_profiles", &self.rail_profiles)
+            .field("rail_profiles_inclined", &self.rail_profiles_inclined)
+            .field("radius", &self.radius)
+            .field("flange_back_distance", &self.flange_back_distance)
+            .field("taping_offset", &self.taping_offset)
+            .field("mu", &self.mu)
+            .field("young", &self.young)
+            .field("poisson", &self.poisson)
+            .field("normal_damping", &self.normal_damping)
+            .field("creep", &self.creep);
+        if self.contact != ContactModel::Hertz {
+            d.field("contact", &self.contact);
+        }
+        d.field("rail", &self.rail)
+            .field("table", &self.table)
+            .field("wheels", &self.wheels)
+            .finish()
+    }
+}
+
+/// The contact model of a wheel–rail element (`contact:`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ContactModel {
+    /// Hertz: per contact point an elliptic patch from the curvatures there,
+    /// the normal force from the approach, the creep forces by `creep`
+    /// (default).
+    Hertz,
+    /// Non-elliptic patches by the modified Kik–Piotrowski method
+    /// ([`railmbs_wheelrail::kik_piotrowski`]): from the virtual penetration
+    /// of the profiles, any number per wheel, the normal force from the
+    /// approach over the patch (Boussinesq), the tangential forces by strips
+    /// on the patch (the `creep` law is not used).
+    KikPiotrowski {
+        /// Penetration-reduction factor ε (–), in (0, 1] (default 0.55).
+        penetration_reduction: Expr,
+        /// Width of the patches' strips, the sampling step of the gap
+        /// across the wheel profile (m; default 1e-4, at most 1e-3).
+        strip_width: f64,
+    },
 }
 
 /// A wheel or rail profile file of a wheel–rail element, read, parsed and
@@ -180,8 +234,12 @@ pub(crate) struct RawWheelRail {
     poisson: Value,
     #[serde(default)]
     normal_damping: Value,
+    /// `None` where not given (the Hertz contact's default law); with
+    /// `contact: KikPiotrowski(..)` it must not be given.
+    #[serde(default, deserialize_with = "given")]
+    creep: Option<CreepLawSpec<Value>>,
     #[serde(default)]
-    creep: CreepLawSpec<Value>,
+    contact: RawContact,
     #[serde(default)]
     rail: RawRail,
     #[serde(default)]
@@ -220,13 +278,24 @@ impl ForceSyntax for RawWheelRail {
                     ("normal_damping", &self.normal_damping),
                 ],
                 rail_profile_inclined: self.rail_profile_inclined,
-                creep: &self.creep,
+                creep: self.creep.as_ref(),
+                contact: &self.contact,
                 rail: &self.rail,
                 table: &self.table,
                 wheels: self.wheels.as_ref(),
             },
         )
     }
+}
+
+/// A field written as its value (`creep: Strip(..)`, not `Some(..)`),
+/// `None` only where it is left out.
+fn given<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    T::deserialize(d).map(Some)
 }
 
 fn default_back_to_back() -> Value {
@@ -247,6 +316,28 @@ fn default_young() -> Value {
 
 fn default_poisson() -> Value {
     Value::Num(0.28)
+}
+
+/// Contact model of a `WheelRail` element.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename = "Contact")]
+pub(crate) enum RawContact {
+    #[default]
+    Hertz,
+    KikPiotrowski {
+        #[serde(default = "default_penetration_reduction")]
+        penetration_reduction: Value,
+        #[serde(default = "default_strip_width")]
+        strip_width: f64,
+    },
+}
+
+fn default_penetration_reduction() -> Value {
+    Value::Num(railmbs_wheelrail::kik_piotrowski::PENETRATION_REDUCTION)
+}
+
+fn default_strip_width() -> f64 {
+    1e-4
 }
 
 /// Rails of a `WheelRail` element.
@@ -317,7 +408,8 @@ struct WheelRailRaw<'r> {
     /// poisson, normal_damping.
     values: [(&'static str, &'r Value); 7],
     rail_profile_inclined: bool,
-    creep: &'r CreepLawSpec<Value>,
+    creep: Option<&'r CreepLawSpec<Value>>,
+    contact: &'r RawContact,
     rail: &'r RawRail,
     table: &'r RawTable,
     /// Independently rotating wheels' bodies (left, right), if any.
@@ -382,9 +474,48 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
         .iter()
         .map(|(key, v)| cx.expr(w, key, key, v, false))
         .collect();
+    let default_law = CreepLawSpec::default();
     let creep = raw
         .creep
+        .unwrap_or(&default_law)
         .map(|key, v| cx.expr(w, &format!("creep.{key}"), key, v, false));
+    let contact = match raw.contact {
+        RawContact::Hertz => ContactModel::Hertz,
+        RawContact::KikPiotrowski {
+            penetration_reduction,
+            strip_width,
+        } => {
+            let strip_width = *strip_width;
+            if raw.creep.is_some() {
+                cx.err(
+                    w,
+                    Some("creep"),
+                    None,
+                    "`creep` is not used with `contact: KikPiotrowski(..)`: its tangential \
+                     forces come from the strips of its own patches; remove `creep`"
+                        .into(),
+                );
+            }
+            if !(strip_width.is_finite() && strip_width > 0.0 && strip_width <= 1e-3) {
+                cx.err(
+                    w,
+                    Some("strip_width"),
+                    None,
+                    format!("strip_width must be in (0, 1e-3] m, got {strip_width}"),
+                );
+            }
+            ContactModel::KikPiotrowski {
+                penetration_reduction: cx.expr(
+                    w,
+                    "contact.penetration_reduction",
+                    "penetration_reduction",
+                    penetration_reduction,
+                    false,
+                ),
+                strip_width,
+            }
+        }
+    };
     let rail = match raw.rail {
         RawRail::Rigid => RailKind::Rigid,
         RawRail::Elastic {
@@ -471,6 +602,7 @@ fn wheel_rail(cx: &mut Cx, w: &Where, lookup: &Lookup, raw: WheelRailRaw) -> Box
         poisson: next(),
         normal_damping: next(),
         creep,
+        contact,
         rail,
         table: ContactTableSpec {
             y_max: t.y_max,
@@ -493,6 +625,7 @@ impl ForceSpec for WheelRail {
             poisson,
             normal_damping,
             creep,
+            contact,
             rail,
             ..
         } = self;
@@ -508,6 +641,13 @@ impl ForceSpec for WheelRail {
             f(e);
         }
         creep.for_each_value_mut(|_, e| f(e));
+        if let ContactModel::KikPiotrowski {
+            penetration_reduction,
+            ..
+        } = contact
+        {
+            f(penetration_reduction);
+        }
         match rail {
             RailKind::Elastic { ky, cy, kz, cz, .. } => {
                 for e in [ky, cy, kz, cz] {
@@ -539,6 +679,19 @@ impl ForceSpec for WheelRail {
         let law = self.creep.map(|_, e| Some(c.value(e)).filter(|x| x.is_finite()).unwrap_or(1.0));
         if let Err(e) = law.validate() {
             c.push("creep", e.to_string());
+        }
+        if let ContactModel::KikPiotrowski {
+            penetration_reduction,
+            ..
+        } = &self.contact
+        {
+            let e = c.value(penetration_reduction);
+            if e.is_finite() && !(e > 0.0 && e <= 1.0) {
+                c.push(
+                    "penetration_reduction",
+                    format!("penetration_reduction must be in (0, 1], got {e}"),
+                );
+            }
         }
         if let RailKind::Elastic { ky, cy, kz, cz, .. } = &self.rail {
             c.positive("ky", ky);

@@ -8,6 +8,7 @@ mod equations;
 mod equilibrium;
 mod freight;
 mod freight_train;
+mod kik_piotrowski_wheelset;
 mod modes;
 mod plugins;
 mod symbolic;

@@ -22,6 +22,7 @@ fn quadratic_gap(b: f64, r: f64, half_width: f64, dy: f64) -> Vec<GapSample> {
             GapSample {
                 wheel_u: y,
                 rail_y: y,
+                rail_z: 0.0,
                 gap: b * y * y,
                 rolling_radius: r,
                 contact_angle: 0.0,
@@ -422,5 +423,54 @@ fn s1002_uic60_strip_width_converged() {
             ea.abs() < 0.01 && ep.abs() < 0.01 && ef < 1e-3,
             "{ea} {ep} {ef}"
         );
+    }
+}
+
+/// `gap_samples_below` (the element's sampling near the patches) returns the
+/// very samples of `gap_samples` wherever the gap is below the bound, each
+/// run bounded by samples at or above it, so the patches are identical:
+/// S1002/UIC60 from the tread through the flange root to the flange, at
+/// several approaches and rolls.
+#[test]
+fn sampling_near_the_patches_gives_the_whole_profiles_patches() {
+    let geo = s1002_uic60();
+    let kp = KikPiotrowski::default();
+    for (y, roll) in [
+        (0.0, 0.0),
+        (3e-3, 2e-4),
+        (4.6e-3, 0.0),
+        (5.1e-3, 4e-4),
+        (8e-3, -1e-3),
+    ] {
+        for side in [0, 1] {
+            let all = geo.gap_samples(side, y, roll, 1e-4).unwrap();
+            let g_min = all.iter().map(|s| s.gap).fold(f64::INFINITY, f64::min);
+            for depth in [1e-5, 5e-5, 2e-4] {
+                let approach = g_min + depth;
+                let near = geo
+                    .gap_samples_below(side, y, roll, 1e-4, approach)
+                    .unwrap();
+                assert!(
+                    near.len() < all.len() / 2,
+                    "{} of {}",
+                    near.len(),
+                    all.len()
+                );
+                let want: Vec<_> = all.iter().filter(|s| s.gap < approach).collect();
+                let got: Vec<_> = near.iter().filter(|s| s.gap < approach).collect();
+                assert_eq!(got, want, "y {y}, roll {roll}, side {side}, depth {depth}");
+                assert!(near.first().unwrap().gap >= approach || near[0] == all[0]);
+                assert!(near.last().unwrap().gap >= approach || near.last() == all.last());
+                assert_eq!(
+                    kp.patches(&near, approach).unwrap(),
+                    kp.patches(&all, approach).unwrap()
+                );
+            }
+            // Nothing close: no samples.
+            let none = geo
+                .gap_samples_below(side, y, roll, 1e-4, g_min - 1e-3)
+                .unwrap();
+            assert!(none.is_empty());
+        }
     }
 }

@@ -12,7 +12,8 @@ use railmbs_track::SpeedLaw;
 impl WheelRailContact {
     /// The output columns: per wheel (`L.`, `R.`) the loads, forces,
     /// creepages and contact data, then ΣY and Nadal's limit, and the rails'
-    /// displacements for elastic rails.
+    /// displacements for elastic rails, and for the non-elliptic contact
+    /// each wheel's total patch area.
     pub(super) fn output_columns(&self) -> Vec<String> {
         let mut names = Vec::new();
         for side in ["L", "R"] {
@@ -44,6 +45,11 @@ impl WheelRailContact {
                 for n in ["rail_dy [m]", "rail_dz [m]"] {
                     names.push(format!("{side}.{n}"));
                 }
+            }
+        }
+        if self.c.non_elliptic.is_some() {
+            for side in ["L", "R"] {
+                names.push(format!("{side}.patch_area [m2]"));
             }
         }
         names
@@ -95,6 +101,11 @@ impl WheelRailContact {
         out.push(self.bound.as_ref().map_or(f64::NAN, |b| b.nadal));
         if self.c.rail.is_some() {
             out.extend(state.rail_d.iter().flatten());
+        }
+        if self.c.non_elliptic.is_some() {
+            for side in 0..2 {
+                out.push(state.side(side).iter().map(|c| c.area).sum());
+            }
         }
     }
 

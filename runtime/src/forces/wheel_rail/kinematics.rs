@@ -72,11 +72,31 @@ pub(super) struct Side<'a> {
     pub(super) wheel: usize,
 }
 
-/// One contact before its normal force is known.
+/// One contact before its normal force is known: its Hertz shape and
+/// approach, and where it is ([`PointKinematics`]).
 pub(super) struct ContactKinematics {
     pub(super) shape: HertzShape,
     /// Approach along the normal (load weight included), m.
     pub(super) approach: f64,
+    pub(super) at: PointKinematics,
+}
+
+impl std::ops::Deref for ContactKinematics {
+    type Target = PointKinematics;
+    fn deref(&self) -> &PointKinematics {
+        &self.at
+    }
+}
+
+impl std::ops::DerefMut for ContactKinematics {
+    fn deref_mut(&mut self) -> &mut PointKinematics {
+        &mut self.at
+    }
+}
+
+/// A contact's point, frame, approach rate and creepages, whatever its
+/// normal problem (Hertz or a non-elliptic patch).
+pub(super) struct PointKinematics {
     /// Normal (n_y, n_z) in the track cross-section.
     pub(super) normal_2d: [f64; 2],
     pub(super) cos_angle: f64,
@@ -223,7 +243,8 @@ impl WheelRailContact {
         if penetration <= 0.0 || weight == 0.0 {
             return Ok(None);
         }
-        let (sd, cd) = c.contact_angle.sin_cos();
+        // (the cosine as `point_kinematics` takes it, bit for bit)
+        let (_, cd) = c.contact_angle.sin_cos();
         // N ∝ approach^{3/2}: the load scales by `weight`.
         let approach = penetration * weight.powf(2.0 / 3.0) * cd;
         // Hertz shape from the curvatures at the contact.
@@ -235,6 +256,25 @@ impl WheelRailContact {
         let curv_b = curv_b.max(MIN_CURVATURE_RATIO * curv_a);
         let shape = HertzShape::with_modulus(curv_a, curv_b, self.c.e_star)
             .map_err(|e| self.diverged(t, format!("Hertz: {e}")))?;
+        let at = self.point_kinematics(s, c, d)?;
+        Ok(Some(ContactKinematics {
+            shape,
+            approach,
+            at,
+        }))
+    }
+
+    /// A contact's point, frame, approach rate and creepages at the contact
+    /// point `c` (its rail point, contact angle and rolling radius) with the
+    /// rail displaced elastically by `d` = (d_y, d_z) (m, track frame).
+    pub(super) fn point_kinematics(
+        &self,
+        s: &Side,
+        c: &Contact,
+        d: [f64; 2],
+    ) -> Result<PointKinematics, SimError> {
+        let t = s.ctx.t;
+        let (sd, cd) = c.contact_angle.sin_cos();
         // Contact point on the (displaced) rail, in the track frame then SC0,
         // first in the axle's plane.
         let mut local = Vector3::new(
@@ -286,9 +326,7 @@ impl WheelRailContact {
         let creepages =
             Creepages::from_velocities(v_wheel.into(), [0.0; 3], omega, [0.0; 3], &frame, s.speed)
                 .map_err(|e| self.diverged(t, e.to_string()))?;
-        Ok(Some(ContactKinematics {
-            shape,
-            approach,
+        Ok(PointKinematics {
             normal_2d: [-s.sign * sd, cd],
             cos_angle: cd,
             point,
@@ -301,6 +339,6 @@ impl WheelRailContact {
             angle: c.contact_angle,
             rail_y: local.y,
             rolling_radius: c.rolling_radius,
-        }))
+        })
     }
 }

@@ -115,6 +115,7 @@
 mod assessment;
 mod elastic;
 mod kinematics;
+mod non_elliptic;
 mod preparation;
 mod solve;
 mod table_cache;

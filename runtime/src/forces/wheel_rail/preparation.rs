@@ -10,12 +10,15 @@ use super::{WheelRailContact, nadal_limit};
 use crate::forces::eval_scalar;
 use crate::system::SimError;
 use crate::track_inputs::RunningSpeed;
-use railmbs_models::{ProfileFile, RailKind};
+use railmbs_models::{ContactModel, ProfileFile, RailKind};
 use railmbs_track::Track;
 use railmbs_wheelrail::creep::{CreepLaw, CreepLawSpec};
 use railmbs_wheelrail::elastic_rail::RailSupport;
-use railmbs_wheelrail::geometry::{self, ContactTable, SearchSettings, TableSettings};
+use railmbs_wheelrail::geometry::{
+    self, ContactGeometry, ContactTable, SearchSettings, TableSettings,
+};
 use railmbs_wheelrail::hertz::effective_modulus;
+use railmbs_wheelrail::kik_piotrowski::KikPiotrowski;
 use railmbs_wheelrail::profile::{Profile, ProfileSettings};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -89,6 +92,14 @@ pub struct PreparedContact {
     pub(super) flange_angle: f64,
 }
 
+/// The profile settings with the rail inclination `rail_inclination` (rad).
+fn profile_settings(rail_inclination: f64) -> ProfileSettings {
+    ProfileSettings {
+        rail_inclination,
+        ..ProfileSettings::default()
+    }
+}
+
 /// Material and law constants from the parameters.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Constants {
@@ -106,6 +117,9 @@ pub(super) struct Constants {
     pub(super) creep: CreepLawSpec,
     /// Elastic rails' support (per rail), or `None` for rigid rails.
     pub(super) rail: Option<RailSupport>,
+    /// The non-elliptic contact (Kik–Piotrowski) and its strip width (m),
+    /// or `None` for Hertz.
+    pub(super) non_elliptic: Option<(KikPiotrowski, f64)>,
 }
 
 /// Where the element is on the track (after [`ForceElement::bind_track`]).
@@ -121,6 +135,9 @@ pub(super) struct Bound {
     /// looked up (1 without a conicity override): s = λ / λ₀, λ the
     /// override, λ₀ the table's own central conicity.
     pub(super) shift_scale: f64,
+    /// The non-elliptic contact's profiles on the track, where its gap is
+    /// sampled at every evaluation (`None` for Hertz).
+    pub(super) geometry: Option<ContactGeometry>,
 }
 
 impl WheelRailContact {
@@ -144,7 +161,23 @@ impl WheelRailContact {
         let nadal = nadal_limit(contact.flange_angle, self.c.mu);
         let shift_scale = match binding.conicity {
             None => 1.0,
-            Some(lambda) => self.shift_scale(&contact, lambda)?,
+            Some(lambda) if self.c.non_elliptic.is_none() => self.shift_scale(&contact, lambda)?,
+            Some(_) => {
+                return Err(self.err(
+                    "the equivalent conicity override scales the contact table's geometry, \
+                     which the Kik–Piotrowski contact does not use: run it with `contact: Hertz`",
+                ));
+            }
+        };
+        let geometry = match self.c.non_elliptic {
+            None => None,
+            Some(_) => {
+                let (wheelset, rails) = self.placed_profiles(binding)?;
+                Some(
+                    ContactGeometry::new(&wheelset, &rails, SearchSettings::default())
+                        .map_err(|e| self.err(format!("contact geometry: {e}")))?,
+                )
+            }
         };
         Ok(Bound {
             track: binding.track.clone(),
@@ -154,6 +187,7 @@ impl WheelRailContact {
             law,
             nadal,
             shift_scale,
+            geometry,
         })
     }
 
@@ -189,15 +223,8 @@ impl WheelRailContact {
     pub(super) fn prepare(&self, binding: &TrackBinding) -> Result<Arc<PreparedContact>, SimError> {
         let track = &binding.track;
         let t = &self.spec.table;
-        let inclination = if self.spec.rail_profiles_inclined {
-            0.0
-        } else {
-            track.rail_inclination().atan()
-        };
-        let settings = |rail_inclination: f64| ProfileSettings {
-            rail_inclination,
-            ..ProfileSettings::default()
-        };
+        let inclination = self.rail_inclination(binding);
+        let settings = profile_settings;
         let [wheel_left, wheel_right] = &self.spec.wheel_profiles;
         let [rail_left, rail_right] = &self.spec.rail_profiles;
         let inputs = TableInputs {
@@ -238,28 +265,8 @@ impl WheelRailContact {
         if let Some(p) = slot.as_ref() {
             return Ok(p.clone());
         }
-        // The profiles were read and validated when the model was loaded;
-        // here they are smoothed, the rails inclined as the track says.
         let build = || {
-            let read = |file: &ProfileFile, settings: ProfileSettings| {
-                Profile::from_points(&file.points, &settings)
-                    .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
-            };
-            let wheelset = geometry::Wheelset::new(
-                read(wheel_left, inputs.wheels[0].1)?,
-                read(wheel_right, inputs.wheels[1].1)?,
-                self.c.radius,
-                self.c.flange_back_distance,
-            );
-            let wheelset = geometry::Wheelset {
-                taping_line_offset: self.c.taping_offset,
-                ..wheelset
-            };
-            let rails = geometry::Track::new(
-                read(rail_left, inputs.rails[0].1)?,
-                read(rail_right, inputs.rails[1].1)?,
-                track.nominal_gauge(),
-            );
+            let (wheelset, rails) = self.placed_profiles(binding)?;
             ContactTable::new(&wheelset, &rails, inputs.search, inputs.table)
                 .map_err(|e| self.err(format!("contact table: {e}")))
         };
@@ -280,6 +287,48 @@ impl WheelRailContact {
         });
         *slot = Some(prepared.clone());
         Ok(prepared)
+    }
+
+    /// The rails' inclination (rad) the profiles are placed with: the
+    /// track's, unless the rail files are drawn inclined.
+    fn rail_inclination(&self, binding: &TrackBinding) -> f64 {
+        if self.spec.rail_profiles_inclined {
+            0.0
+        } else {
+            binding.track.rail_inclination().atan()
+        }
+    }
+
+    /// The wheelset and rails of the element's profiles (read and validated
+    /// when the model was loaded) on the track: smoothed, the rails inclined
+    /// as [`Self::rail_inclination`] says.
+    fn placed_profiles(
+        &self,
+        binding: &TrackBinding,
+    ) -> Result<(geometry::Wheelset, geometry::Track), SimError> {
+        let read = |file: &ProfileFile, rail_inclination: f64| {
+            Profile::from_points(&file.points, &profile_settings(rail_inclination))
+                .map_err(|e| self.err(format!("{}: {e}", file.path.display())))
+        };
+        let inclination = self.rail_inclination(binding);
+        let [wheel_left, wheel_right] = &self.spec.wheel_profiles;
+        let [rail_left, rail_right] = &self.spec.rail_profiles;
+        let wheelset = geometry::Wheelset::new(
+            read(wheel_left, 0.0)?,
+            read(wheel_right, 0.0)?,
+            self.c.radius,
+            self.c.flange_back_distance,
+        );
+        let wheelset = geometry::Wheelset {
+            taping_line_offset: self.c.taping_offset,
+            ..wheelset
+        };
+        let rails = geometry::Track::new(
+            read(rail_left, inclination)?,
+            read(rail_right, inclination)?,
+            binding.track.nominal_gauge(),
+        );
+        Ok((wheelset, rails))
     }
 
     /// The constants at the parameter values `params` (in
@@ -319,7 +368,40 @@ impl WheelRailContact {
                     lateral_damping: *lateral_damping,
                 }),
             },
+            non_elliptic: match &s.contact {
+                ContactModel::Hertz => None,
+                ContactModel::KikPiotrowski {
+                    penetration_reduction,
+                    strip_width,
+                } => Some((
+                    KikPiotrowski {
+                        penetration_reduction: ev(penetration_reduction, "penetration_reduction")?,
+                        young,
+                        poisson,
+                    },
+                    *strip_width,
+                )),
+            },
         };
+        if let Some((kp, width)) = &c.non_elliptic {
+            let e = kp.penetration_reduction;
+            if !(e.is_finite() && e > 0.0 && e <= 1.0) {
+                return Err(self.err(format!(
+                    "contact: KikPiotrowski: penetration_reduction must be in (0, 1], got {e}"
+                )));
+            }
+            if !(width.is_finite() && *width > 0.0 && *width <= 1e-3) {
+                return Err(self.err(format!(
+                    "contact: KikPiotrowski: strip_width must be in (0, 1e-3] m, got {width} m"
+                )));
+            }
+            if c.rail.is_some() {
+                return Err(self.err(
+                    "contact: KikPiotrowski is not available with elastic rails (their \
+                     equilibrium is solved for Hertz contacts): use `rail: Rigid`",
+                ));
+            }
+        }
         for (field, v) in [
             ("radius", c.radius),
             ("flange_back_distance", c.flange_back_distance),

@@ -4,7 +4,7 @@
 //! outputs, the Jacobian and the accepted step that ask for the same state.
 
 use super::WheelRailContact;
-use super::kinematics::ContactKinematics;
+use super::kinematics::{ContactKinematics, PointKinematics};
 use crate::forces::{ForceContext, ForceJacobian};
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
@@ -47,7 +47,14 @@ pub(super) struct ContactState {
     pub(super) dissipation: f64,
     /// Elastic energy of the Hertz contact, (2/5) N δ (N ∝ δ^{3/2}), J.
     pub(super) elastic_energy: f64,
+    /// Area of the contact patch, m² (π a b for a Hertz ellipse).
+    pub(super) area: f64,
 }
+
+/// Most contacts (patches) of one wheel an element keeps: two for Hertz (the
+/// tread and flange regions), any up to this many for the non-elliptic
+/// contact.
+pub(super) const MAX_CONTACTS: usize = 4;
 
 impl ContactState {
     /// Total force on the wheel, SC0, N.
@@ -59,8 +66,8 @@ impl ContactState {
 /// Both wheels at one state.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct WheelsetState {
-    /// Per side (left, right): contacts (up to two) and how many.
-    pub(super) contacts: [[ContactState; 2]; 2],
+    /// Per side (left, right): contacts (up to [`MAX_CONTACTS`]) and how many.
+    pub(super) contacts: [[ContactState; MAX_CONTACTS]; 2],
     pub(super) count: [usize; 2],
     /// Track frame axes in SC0 (columns x, y, z).
     pub(super) track_axes: Matrix3<f64>,
@@ -123,6 +130,11 @@ impl WheelRailContact {
             ..WheelsetState::default()
         };
         match self.c.rail {
+            None if self.c.non_elliptic.is_some() => {
+                for geo in &sides {
+                    self.solve_non_elliptic_side(geo, &mut state)?;
+                }
+            }
             None => {
                 let left = self.lookup(&sides[0], 0.0)?;
                 let right = if sides[1].y == sides[0].y {
@@ -214,7 +226,7 @@ impl WheelRailContact {
     /// (N/m) and the creep forces.
     pub(super) fn contact_state(
         &self,
-        k: &ContactKinematics,
+        k: &PointKinematics,
         patch: &ContactPatch,
         (normal, stiffness): (f64, f64),
         forces: CreepForces,
@@ -254,6 +266,7 @@ impl WheelRailContact {
                     + forces.mz * k.creepages.phi)
                 + damper_power,
             elastic_energy,
+            area: std::f64::consts::PI * patch.a * patch.b,
         })
     }
 
