@@ -54,6 +54,9 @@ impl<T: OutputSink + ?Sized> OutputSink for &mut T {
     }
 }
 
+/// Capacity of a [`CsvFile`]'s write buffer, bytes.
+const CSV_BUFFER_BYTES: usize = 1 << 18;
+
 /// A CSV file: the header line, then one line per row with each value in
 /// Rust's shortest round-trip form (`{}`), comma-separated.
 #[derive(Debug)]
@@ -122,7 +125,9 @@ impl OutputSink for CsvFile {
             })?;
         }
         let file = std::fs::File::create(p).map_err(|e| self.io(e))?;
-        let mut w = std::io::BufWriter::new(file);
+        // A row of a vehicle run is a few kB: a larger buffer than the
+        // default 8 kB writes it to the file in fewer system calls.
+        let mut w = std::io::BufWriter::with_capacity(CSV_BUFFER_BYTES, file);
         writeln!(w, "{}", header.join(",")).map_err(|e| self.io(e))?;
         self.writer = Some(w);
         Ok(())
@@ -140,8 +145,8 @@ impl OutputSink for CsvFile {
             }
             let _ = write!(self.line, "{x}");
         }
-        let written = writeln!(w, "{}", self.line);
-        written.map_err(|e| self.io(e))
+        self.line.push('\n');
+        w.write_all(self.line.as_bytes()).map_err(|e| self.io(e))
     }
 
     fn finish(&mut self) -> Result<(), RunError> {

@@ -57,13 +57,19 @@ impl WheelRailContact {
 
     /// Appends the values of [`Self::output_columns`] at the context's state.
     pub(super) fn write_outputs(&self, ctx: &ForceContext, out: &mut Vec<f64>) {
-        let Ok(state) = self.solve(ctx) else {
+        if self
+            .solved(ctx, |state| self.write_state(state, out))
+            .is_err()
+        {
             // Only at an interpolated output state the steps never visited
             // (the step states themselves were solved): NaN marks the gap.
             out.extend(std::iter::repeat_n(f64::NAN, self.output_columns().len()));
-            return;
-        };
-        let loads = Self::wheel_loads(&state);
+        }
+    }
+
+    /// [`Self::write_outputs`] of a solved state.
+    fn write_state(&self, state: &WheelsetState, out: &mut Vec<f64>) {
+        let loads = Self::wheel_loads(state);
         for (side, &(q, y)) in loads.iter().enumerate() {
             let contacts = state.side(side);
             let sum = |f: &dyn Fn(&ContactState) -> f64| contacts.iter().map(f).sum::<f64>();
@@ -113,7 +119,7 @@ impl WheelRailContact {
     /// the wheelset's distance along the track, (Q, Y) per wheel and Nadal's
     /// limit; `None` if the contacts cannot be solved there.
     pub(super) fn wheel_loads_at(&self, ctx: &ForceContext) -> Option<WheelLoads> {
-        let state = self.solve(ctx).ok()?;
+        let loads = self.solved(ctx, Self::wheel_loads).ok()?;
         // The distance s of the wheelset along the track.
         let distance = self
             .bound
@@ -121,7 +127,7 @@ impl WheelRailContact {
             .and_then(|b| b.speed.motion(ctx.t).ok().map(|m| m.s + b.offset));
         Some(WheelLoads {
             distance,
-            loads: Self::wheel_loads(&state),
+            loads,
             nadal: self.bound.as_ref().map(|b| b.nadal),
         })
     }

@@ -9,7 +9,7 @@ use super::preparation::Bound;
 use crate::forces::ForceContext;
 use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
-use railmbs_track::SpeedLaw;
+use railmbs_track::{SpeedLaw, TrackFrame};
 use railmbs_wheelrail::creep::Creepages;
 use railmbs_wheelrail::creepage::ContactFrame;
 use railmbs_wheelrail::geometry::Contact;
@@ -125,15 +125,7 @@ impl WheelRailContact {
         b: &'a Bound,
     ) -> Result<[Side<'a>; 2], SimError> {
         let t = ctx.t;
-        let motion = b
-            .speed
-            .motion(t)
-            .map_err(|e| self.diverged(t, format!("running speed: {e}")))?;
-        let s = motion.s + b.offset;
-        let frame = b
-            .track
-            .frame(s, motion.s_dot, motion.s_ddot)
-            .map_err(|e| self.diverged(t, format!("track at s = {s:.3} m: {e}")))?;
+        let (s, frame) = self.design_frame(t, b)?;
         let r = &frame.rotation;
         let axes = Matrix3::new(
             r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
@@ -184,6 +176,32 @@ impl WheelRailContact {
             wheel: self.wheel_body(side),
         });
         Ok(sides)
+    }
+
+    /// The arc position (m) of the wheelset's track-following frame at time
+    /// `t` (s) and the design track frame there: a function of the time
+    /// alone, kept for the last time asked (a step's Newton iterations, its
+    /// Jacobian and its acceptance share one time), so the same numbers.
+    fn design_frame(&self, t: f64, b: &Bound) -> Result<(f64, TrackFrame), SimError> {
+        if let Ok(last) = self.frame_at.lock()
+            && let Some((bits, s, frame)) = *last
+            && bits == t.to_bits()
+        {
+            return Ok((s, frame));
+        }
+        let motion = b
+            .speed
+            .motion(t)
+            .map_err(|e| self.diverged(t, format!("running speed: {e}")))?;
+        let s = motion.s + b.offset;
+        let frame = b
+            .track
+            .frame(s, motion.s_dot, motion.s_ddot)
+            .map_err(|e| self.diverged(t, format!("track at s = {s:.3} m: {e}")))?;
+        if let Ok(mut last) = self.frame_at.lock() {
+            *last = Some((t.to_bits(), s, frame));
+        }
+        Ok((s, frame))
     }
 
     /// The contact table's region contacts for a side's wheelset position

@@ -150,6 +150,10 @@ pub struct WheelRailContact {
     /// The kinematics are the wheelset's and each wheel's body's (the same
     /// body thrice for a solid wheelset).
     last: std::sync::Mutex<Option<(f64, [BodyKinematics; 3], WheelsetState)>>,
+    /// The time (its bits), arc position and design track frame of the
+    /// wheelset's track-following frame last asked for (see
+    /// `design_frame`); cleared when the track is bound.
+    frame_at: std::sync::Mutex<Option<(u64, f64, railmbs_track::TrackFrame)>>,
     /// Elastic rails: the rails at the last accepted step. Only
     /// [`ForceElement::accept_step`] changes it; every evaluation until the
     /// next accepted step (Newton iterations, Jacobians, the output rows of
@@ -183,6 +187,7 @@ impl WheelRailContact {
             c: Constants::default(),
             bound: None,
             last: std::sync::Mutex::new(None),
+            frame_at: std::sync::Mutex::new(None),
             rail_accepted: None,
             placeholder_shape: HertzShape::with_modulus(1.0, 1.0, 1.0).ok(),
         }
@@ -239,6 +244,7 @@ impl ForceElement for WheelRailContact {
         }
         self.c = c;
         *self.last.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.frame_at.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
         self.rail_accepted = None;
         Ok(())
     }
@@ -249,19 +255,21 @@ impl ForceElement for WheelRailContact {
 
     fn bind_track(&mut self, binding: &TrackBinding) -> Result<(), SimError> {
         self.bound = Some(self.bind(binding)?);
+        *self.frame_at.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.last.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
         Ok(())
     }
 
     fn apply(&self, ctx: &ForceContext, wrenches: &mut [Wrench]) -> Result<(), SimError> {
-        let state = self.solve(ctx)?;
-        for side in 0..2 {
-            let body = Some(self.wheel_body(side));
-            for c in state.side(side) {
-                add_force(wrenches, ctx, body, &c.point, &c.force());
-                add_moment(wrenches, body, &(c.n * c.forces.mz));
+        self.solved(ctx, |state| {
+            for side in 0..2 {
+                let body = Some(self.wheel_body(side));
+                for c in state.side(side) {
+                    add_force(wrenches, ctx, body, &c.point, &c.force());
+                    add_moment(wrenches, body, &(c.n * c.forces.mz));
+                }
             }
-        }
-        Ok(())
+        })
     }
 
     fn output_names(&self) -> Vec<String> {
@@ -282,12 +290,12 @@ impl ForceElement for WheelRailContact {
     }
 
     fn accept_step(&mut self, ctx: &ForceContext) -> Result<(), SimError> {
-        let state = self.solve(ctx)?;
+        let (rail_d, rail_creep) = self.solved(ctx, |state| (state.rail_d, state.rail_creep))?;
         // Elastic rails: this step's rail displacements become the start of
         // the next step's damper rate (never changed inside Newton
         // iterations or by rejected steps).
         if self.c.rail.is_some() {
-            self.rail_accepted = Some((ctx.t, state.rail_d, state.rail_creep));
+            self.rail_accepted = Some((ctx.t, rail_d, rail_creep));
         }
         Ok(())
     }

@@ -93,27 +93,33 @@ impl WheelsetState {
 }
 
 impl WheelRailContact {
-    /// [`Self::solve_new`], or the stored result for the same time and
-    /// wheelset kinematics (the axle's and, for independently rotating wheels,
-    /// the wheels', whose spin alone changes the creep forces).
-    pub(super) fn solve(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+    /// `f` of [`Self::solve_new`]'s result, or of the stored result for the
+    /// same time and wheelset kinematics (the axle's and, for independently
+    /// rotating wheels, the wheels', whose spin alone changes the creep
+    /// forces). `f` sees the stored state in place: the state (about 1 kB)
+    /// is not copied out for every force, output and Jacobian call.
+    pub(super) fn solved<R>(
+        &self,
+        ctx: &ForceContext,
+        f: impl FnOnce(&WheelsetState) -> R,
+    ) -> Result<R, SimError> {
         let body = [
             ctx.bodies[self.spec.wheelset],
             ctx.bodies[self.wheel_body(0)],
             ctx.bodies[self.wheel_body(1)],
         ];
-        if let Ok(last) = self.last.lock()
-            && let Some((t, k, state)) = last.as_ref()
+        let Ok(mut last) = self.last.lock() else {
+            return Ok(f(&self.solve_new(ctx)?));
+        };
+        if let Some((t, k, state)) = last.as_ref()
             && *t == ctx.t
             && *k == body
         {
-            return Ok(*state);
+            return Ok(f(state));
         }
         let state = self.solve_new(ctx)?;
-        if let Ok(mut last) = self.last.lock() {
-            *last = Some((ctx.t, body, state));
-        }
-        Ok(state)
+        let (_, _, state) = last.insert((ctx.t, body, state));
+        Ok(f(state))
     }
 
     /// Solves both wheels' contacts at the context's state.
@@ -279,27 +285,27 @@ impl WheelRailContact {
         ctx: &ForceContext,
         jac: &mut ForceJacobian,
     ) -> Result<(), SimError> {
-        let state = self.solve(ctx)?;
-        for side in 0..2 {
-            for c in state.side(side) {
-                // f = N n + Fx eₓ + Fy eᵧ on the wheel at the contact point;
-                // d = wheel point − rail point (at rest): ∂N/∂d = −k n,
-                // ∂F/∂ḋ ≈ −(f11/V) eₓeₓᵀ − (f22/V) eᵧeᵧᵀ − c_n nnᵀ.
-                let nn = c.n * c.n.transpose();
-                let kq = -c.normal_stiffness * nn;
-                let kv = -(c.f11 / c.speed) * (c.ex * c.ex.transpose())
-                    - (c.f22 / c.speed) * (c.ey * c.ey.transpose())
-                    - self.c.normal_damping * nn;
-                jac.add_point_pair(
-                    None,
-                    &c.point,
-                    Some(self.wheel_body(side)),
-                    &c.point,
-                    &kq,
-                    &kv,
-                );
+        self.solved(ctx, |state| {
+            for side in 0..2 {
+                for c in state.side(side) {
+                    // f = N n + Fx eₓ + Fy eᵧ on the wheel at the contact point;
+                    // d = wheel point − rail point (at rest): ∂N/∂d = −k n,
+                    // ∂F/∂ḋ ≈ −(f11/V) eₓeₓᵀ − (f22/V) eᵧeᵧᵀ − c_n nnᵀ.
+                    let nn = c.n * c.n.transpose();
+                    let kq = -c.normal_stiffness * nn;
+                    let kv = -(c.f11 / c.speed) * (c.ex * c.ex.transpose())
+                        - (c.f22 / c.speed) * (c.ey * c.ey.transpose())
+                        - self.c.normal_damping * nn;
+                    jac.add_point_pair(
+                        None,
+                        &c.point,
+                        Some(self.wheel_body(side)),
+                        &c.point,
+                        &kq,
+                        &kv,
+                    );
+                }
             }
-        }
-        Ok(())
+        })
     }
 }
