@@ -186,11 +186,34 @@ impl Section {
                     ));
                 }
             }
-            SectionKind::Clothoid => {}
+            SectionKind::Clothoid => {
+                // The plan position is integrated in sub-intervals of at most
+                // 1 rad of turning (`local_position`), so the turning bounds
+                // the work of every position query in the section.
+                let turning = (self.curvature_start.abs()
+                    + self.curvature_rate().abs() * self.length)
+                    * self.length;
+                if turning > MAX_CLOTHOID_TURNING {
+                    return Err(invalid(
+                        format!("section {i} (transition)"),
+                        format!(
+                            "turns by {turning:.3e} rad over its {} m (curvature {} -> {} 1/m); \
+                             a transition curve turns by at most {MAX_CLOTHOID_TURNING} rad",
+                            self.length, self.curvature_start, self.curvature_end
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
     }
 }
+
+/// Largest turning of a transition (clothoid) section, (|κ₀| + |κ'| L) L,
+/// rad: 1000 rad is 159 full turns, far beyond any track's transition (a
+/// few hundredths of a radian), and bounds the plan integration to 1000
+/// sub-intervals per position query.
+pub const MAX_CLOTHOID_TURNING: f64 = 1000.0;
 
 /// Plan position and heading at the start of the alignment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -198,6 +198,27 @@ fn bad_inputs_are_errors() {
     ])
     .unwrap();
     assert!(Track::new(a).is_err());
+    // A transition of astronomic length (found by the track fuzz target: its
+    // plan integration would take ~1e75 steps) is refused, named.
+    let e = Alignment::new(vec![
+        Section::straight(50.0),
+        Section::entry_transition(4.3e78, 600.0, Direction::Right),
+    ])
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("section 1 (transition)") && e.contains("turns by"),
+        "{e}"
+    );
+    // A real one passes (100 m into a 150 m radius: 0.33 rad).
+    assert!(
+        Alignment::new(vec![Section::entry_transition(
+            100.0,
+            150.0,
+            Direction::Left
+        )])
+        .is_ok()
+    );
 }
 
 #[test]
