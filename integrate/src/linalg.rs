@@ -255,6 +255,25 @@ fn is_positive_pivot(d: f64) -> bool {
     d > 0.0 && d < f64::INFINITY
 }
 
+/// Ends column j of L in place: its pivot (the updated diagonal entry
+/// `col_j[0]`) becomes √d and the entries below are divided by it; false if
+/// the pivot is not positive and finite. Shared by the factorization and
+/// its test reference.
+#[inline(always)]
+fn finish_column(col_j: &mut [f64]) -> bool {
+    let d = col_j[0];
+    if !is_positive_pivot(d) {
+        return false;
+    }
+    let ljj = d.sqrt();
+    col_j[0] = ljj;
+    let inv = 1.0 / ljj;
+    for x in &mut col_j[1..] {
+        *x *= inv;
+    }
+    true
+}
+
 /// Rows of a column of L accumulated together in registers by
 /// [`cholesky_kernel`] (four SSE2 or two AVX registers).
 const ROW_BLOCK: usize = 8;
@@ -317,15 +336,8 @@ fn cholesky_kernel(data: &mut [f64], n: usize) -> bool {
                 *block = column_rows(left, n, j, j + start, *block);
             }
         }
-        let d = col_j[0];
-        if !is_positive_pivot(d) {
+        if !finish_column(col_j) {
             return false;
-        }
-        let ljj = d.sqrt();
-        col_j[0] = ljj;
-        let inv = 1.0 / ljj;
-        for x in &mut col_j[1..] {
-            *x *= inv;
         }
     }
     true
@@ -459,15 +471,8 @@ fn cholesky_reference(data: &mut [f64], n: usize) -> bool {
                 }
             }
         }
-        let d = col_j[0];
-        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+        if !finish_column(col_j) {
             return false;
-        }
-        let ljj = d.sqrt();
-        col_j[0] = ljj;
-        let inv = 1.0 / ljj;
-        for x in &mut col_j[1..] {
-            *x *= inv;
         }
     }
     true
