@@ -41,7 +41,9 @@ pub struct Args {
     /// Linear solver of Park's method (overrides the integrator's `solver`):
     /// `dense` LU of the whole iteration matrix, or `block`, the bordered
     /// block-diagonal LU of a train (vehicles as blocks, the coupled bodies'
-    /// coordinates as the border; dense for models without that structure).
+    /// coordinates as the border) or of a vehicle (bogies as blocks, the car
+    /// body and what joins it as the border); dense for models without that
+    /// structure.
     #[arg(long, value_enum)]
     pub solver: Option<Solver>,
 }

@@ -331,6 +331,25 @@ impl BlockMatrix {
         }
     }
 
+    /// Overwrites every entry the pattern holds with the dense n × n `m`'s
+    /// (the inverse of [`BlockMatrix::to_dense`]; `m`'s entries outside the
+    /// pattern, structurally zero, are not read).
+    pub fn copy_from_dense(&mut self, m: &DMatrix<f64>) {
+        let p = &self.pattern;
+        for (d, r) in self.diag.iter_mut().zip(&p.blocks) {
+            d.copy_from(&m.view((r.start, r.start), (r.len(), r.len())));
+        }
+        for (b, &j) in p.border.iter().enumerate() {
+            for (a, &i) in p.border.iter().enumerate() {
+                self.coupling[(a, b)] = if p.block_of[i] != p.block_of[j] {
+                    m[(i, j)]
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+
     /// The dense n × n matrix (for tests and for solves that need it).
     pub fn to_dense(&self) -> DMatrix<f64> {
         let p = &self.pattern;
@@ -686,6 +705,23 @@ mod tests {
         let mut y = vec![1.0; 21];
         lu.solve_in_place(&mut y);
         assert!(residual(&dense, &y, &[1.0; 21]) < 1e-13);
+    }
+
+    /// `copy_from_dense` is the inverse of `to_dense`: every entry of the
+    /// pattern is read back, stale entries are overwritten (the coupling of
+    /// two border coordinates of one block stays zero there).
+    #[test]
+    fn copy_from_dense_inverts_to_dense() {
+        let blocks = [0..7, 7..12, 12..21];
+        let border = [5, 6, 7, 8, 19, 20];
+        let a = bordered(&blocks, &border, 29);
+        let dense = a.to_dense();
+        let mut b = bordered(&blocks, &border, 31);
+        b.copy_from_dense(&dense);
+        assert_eq!(b.to_dense(), dense);
+        for (u, w) in b.slices().zip(a.slices()) {
+            assert_eq!(u, w);
+        }
     }
 
     /// A block whose interior needs a pivot from the border (its interior

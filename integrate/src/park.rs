@@ -134,7 +134,8 @@ pub enum LinearSolver {
     /// The bordered block-diagonal LU of [`crate::block`] with M and the
     /// Jacobians assembled blockwise, when the system has a block pattern
     /// ([`MechanicalSystem::block_pattern`]: a train's vehicles coupled
-    /// through their couplers' bodies) and no constraints; the dense LU
+    /// through their couplers' bodies, a vehicle's bogies through the car
+    /// body) and no constraints; the dense LU
     /// otherwise. Same solutions to rounding (the summation order differs).
     /// The default: systems without a pattern solve exactly as with
     /// [`LinearSolver::Dense`].

@@ -161,8 +161,7 @@ pub trait MechanicalSystem {
         let n = self.dof();
         let mut dense = DMatrix::zeros(n, n);
         self.dynamics(t, q, v, &mut dense, force)?;
-        mass.fill_zero();
-        scatter_dense(&dense, mass);
+        mass.copy_from_dense(&dense);
         Ok(())
     }
 
@@ -183,24 +182,9 @@ pub trait MechanicalSystem {
         if !self.force_jacobian(t, q, v, &mut dq, &mut dv)? {
             return Ok(false);
         }
-        dfdq.fill_zero();
-        dfdv.fill_zero();
-        scatter_dense(&dq, dfdq);
-        scatter_dense(&dv, dfdv);
+        dfdq.copy_from_dense(&dq);
+        dfdv.copy_from_dense(&dv);
         Ok(true)
-    }
-}
-
-/// Adds the entries of the dense `m` that `out`'s pattern holds to `out`
-/// (entries outside the pattern, structurally zero, are skipped).
-fn scatter_dense(m: &DMatrix<f64>, out: &mut BlockMatrix) {
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            let x = m[(i, j)];
-            if x != 0.0 {
-                out.add(i, j, x);
-            }
-        }
     }
 }
 

@@ -21,11 +21,15 @@ pub enum JacobianKind {
 pub enum LinearSolverKind {
     /// Dense LU of the whole matrix (every model; the reference).
     Dense,
-    /// Trains: the vehicles as diagonal blocks and the coordinates of the
-    /// coupled bodies as the border, factorized by the bordered
-    /// block-diagonal LU (work linear in the number of vehicles). Models
-    /// without such structure (one vehicle) and constrained trains use the
-    /// dense LU. The default.
+    /// The bordered block-diagonal LU where the model has such structure:
+    /// in trains the vehicles are the diagonal blocks and the coordinates
+    /// of the coupled bodies the border (work linear in the number of
+    /// vehicles); in a vehicle the top-level subsystems (bogies) are blocks
+    /// besides the vehicle's own bodies, and the coordinates that couple
+    /// across them (car body, bogie frames or bolsters) the border, when
+    /// that saves at least half of the dense work. Models without such
+    /// structure, with cut joints or with element states (series springs)
+    /// use the dense LU. The default.
     #[default]
     Block,
 }

@@ -525,6 +525,15 @@ impl TrainSystem {
 }
 
 impl TrainSystem {
+    /// The vehicle of a train of one vehicle without couplers: it is then
+    /// solved with its own block pattern.
+    fn lone_vehicle(&self) -> Option<&ModelSystem> {
+        match &self.vehicles[..] {
+            [vehicle] if self.couplers.is_empty() => Some(vehicle),
+            _ => None,
+        }
+    }
+
     /// Adds the couplers' generalized forces to `force` (the vehicles' last
     /// evaluations give the bodies' kinematics and Jacobians).
     fn add_coupler_forces(&mut self, t: f64, force: &mut DVector<f64>) -> Result<(), SimError> {
@@ -769,10 +778,15 @@ impl MechanicalSystem for TrainSystem {
 
     /// The vehicles as diagonal blocks, the coordinates of the bodies that
     /// couplers join as the border (from the model tree: a body's pose
-    /// depends on its own and its ancestors' coordinates); `None` for a
-    /// single vehicle or when the border is so large that the bordered
-    /// factorization would not save half of the dense work.
+    /// depends on its own and its ancestors' coordinates); `None` when the
+    /// border is so large that the bordered factorization would not save
+    /// half of the dense work. A train of one vehicle and no couplers has
+    /// that vehicle's own pattern (its bogies as blocks, [`ModelSystem`]'s),
+    /// so that it runs exactly as the vehicle's plain scenario.
     fn block_pattern(&self) -> Option<Arc<BlockPattern>> {
+        if let Some(vehicle) = self.lone_vehicle() {
+            return vehicle.block_pattern();
+        }
         self.pattern.clone().filter(|p| p.pays())
     }
 
@@ -786,6 +800,9 @@ impl MechanicalSystem for TrainSystem {
         mass: &mut BlockMatrix,
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
+        if self.lone_vehicle().is_some() {
+            return self.vehicles[0].dynamics_blocks(t, q, v, mass, force);
+        }
         {
             let ranges = &self.ranges;
             let mut items: Vec<_> = self
@@ -815,6 +832,9 @@ impl MechanicalSystem for TrainSystem {
         dfdq: &mut BlockMatrix,
         dfdv: &mut BlockMatrix,
     ) -> Result<bool, SimError> {
+        if self.lone_vehicle().is_some() {
+            return self.vehicles[0].force_jacobian_blocks(t, q, v, dfdq, dfdv);
+        }
         if !self.vehicle_jacobians(t, q, v, dfdq.blocks_mut(), dfdv.blocks_mut())? {
             return Ok(false);
         }

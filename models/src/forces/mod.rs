@@ -157,6 +157,14 @@ macro_rules! force_elements {
                     $( ForceKind::$variant(s) => s.bodies_mut(f), )*
                 }
             }
+
+            /// The body indices the element refers to, in visiting order
+            /// (ground is not a body and is not listed).
+            pub fn bodies(&self) -> Vec<usize> {
+                let mut out = Vec::new();
+                self.clone().bodies_mut(&mut |b| out.push(*b));
+                out
+            }
         }
 
         impl ForceSpec for ForceKind {

@@ -1,6 +1,7 @@
 //! The integration tests of `tests`, one module per topic, linked into one
 //! test binary.
 
+mod block_solve;
 mod cooperrider;
 mod curving;
 mod dynamics;

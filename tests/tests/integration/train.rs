@@ -542,14 +542,11 @@ fn train_file_errors_name_the_element_and_position() {
 /// 1e-10 relative; the residual of both solutions is at rounding level.
 #[test]
 fn the_block_solve_of_a_train_matches_the_dense_solve() {
-    use railmbs_runtime::integrate::linalg::DenseLu;
-    use railmbs_runtime::integrate::{BlockMatrix, BorderedLu};
     let train = train3(1.0);
     let models = vehicle_models(&train);
     let refs: Vec<&Model> = models.iter().collect();
     let engines = models.iter().map(numeric).collect();
     let mut setup = railmbs_runtime::train::build_train(&train, &refs, engines).unwrap();
-    let n = setup.system.dof();
     let mut rng = seeded_rng(11);
     let mut q = setup.q0.clone();
     let mut v = setup.v0.clone();
@@ -579,60 +576,7 @@ fn the_block_solve_of_a_train_matches_the_dense_solve() {
         .flat_map(|&s| own.iter().map(move |&i| s + i))
         .collect();
     assert_eq!(pattern.border(), &expect[..]);
-    let (mut mass, mut f) = (nalgebra::DMatrix::zeros(n, n), nalgebra::DVector::zeros(n));
-    let (mut dq, mut dv) = (
-        nalgebra::DMatrix::zeros(n, n),
-        nalgebra::DMatrix::zeros(n, n),
-    );
-    sys.dynamics(0.1, &q, &v, &mut mass, &mut f).unwrap();
-    assert!(sys.force_jacobian(0.1, &q, &v, &mut dq, &mut dv).unwrap());
-    let z = || BlockMatrix::zeros(&pattern);
-    let (mut mb, mut dqb, mut dvb, mut ab) = (z(), z(), z(), z());
-    let mut fb = nalgebra::DVector::zeros(n);
-    sys.dynamics_blocks(0.1, &q, &v, &mut mb, &mut fb).unwrap();
-    assert!(
-        sys.force_jacobian_blocks(0.1, &q, &v, &mut dqb, &mut dvb)
-            .unwrap()
-    );
-    assert_eq!(f, fb);
-    assert_eq!(mb.to_dense(), mass);
-    assert_eq!(dqb.to_dense(), dq);
-    assert_eq!(dvb.to_dense(), dv);
-    let beta = 6e-4;
-    ab.set_iteration_matrix(&mb, &dvb, &dqb, beta);
-    let a = &mass - &dv * beta - &dq * (beta * beta);
-    for (label, dense, blocks) in [("iteration matrix", &a, &ab), ("M", &mass, &mb)] {
-        let b: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin() * 1e3).collect();
-        let mut lu = DenseLu::new(n);
-        lu.matrix_mut().copy_from(dense);
-        lu.factorize().unwrap();
-        let mut xd = b.clone();
-        lu.solve_slice(&mut xd);
-        let mut blu = BorderedLu::new(&pattern);
-        blu.factorize(blocks).unwrap();
-        assert!(
-            !blu.uses_dense(),
-            "{label}: no pivot outside a block needed"
-        );
-        let mut xb = b.clone();
-        blu.solve_in_place(&mut xb);
-        let scale = xd.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        for (i, (u, w)) in xb.iter().zip(&xd).enumerate() {
-            assert!(
-                (u - w).abs() <= 1e-10 * scale,
-                "{label}: x[{i}] = {u} (block) vs {w} (dense)"
-            );
-        }
-        let bn = b.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        for x in [&xd, &xb] {
-            let r = dense * nalgebra::DVector::from_column_slice(x);
-            let res = r
-                .iter()
-                .zip(&b)
-                .fold(0.0_f64, |m, (u, w)| m.max((u - w).abs()));
-            assert!(res <= 1e-10 * bn, "{label}: residual {res:e}");
-        }
-    }
+    crate::block_solve::assert_block_solve_matches_dense(sys, &pattern, &q, &v);
 }
 
 /// The dense and the block-bordered linear solver run the three-coach train
