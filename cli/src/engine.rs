@@ -1,7 +1,7 @@
 //! Choosing the equations-of-motion engine for a model.
 
 use railmbs_codegen::{GenerateOptions, PluginFile};
-use railmbs_models::Model;
+use railmbs_models::{IntegratorSpec, Model};
 use railmbs_runtime::{Equations, Formalism, NumericEquations, Plugin, PluginEquations};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 /// Which engine computes the equations of motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Engine {
-    /// Recursive numeric-iterative evaluation, no code generation.
+    /// Recursive numeric-iterative evaluation, no code generation (composite
+    /// bodies; for RK4 runs of open trees of 40 coordinates or more the
+    /// articulated-body formalism, [`build_run_engine`]).
     Numeric,
     /// A compiled symbolic plugin (built through the cache when none is given).
     Symbolic,
@@ -79,6 +81,26 @@ pub fn build_engine(
     plugin: Option<&Path>,
 ) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
     build_engine_with(model, engine, plugin, false)
+}
+
+/// [`build_engine`] for a run integrated by `integrator`: with
+/// [`Engine::Numeric`] and RK4 the formalism is the faster one for the
+/// model's size ([`Formalism::for_explicit_integration`]: articulated-body
+/// q̈ for open trees of 40 coordinates or more); Park's method keeps the
+/// composite-body M it needs. The run summary's engine line names the one
+/// used (`numeric` or `numeric-aba`).
+pub fn build_run_engine(
+    model: &Model,
+    engine: Engine,
+    plugin: Option<&Path>,
+    integrator: &IntegratorSpec,
+) -> Result<Box<dyn Equations>, Box<dyn std::error::Error>> {
+    match (engine, integrator) {
+        (Engine::Numeric, IntegratorSpec::Rk4 { .. }) => Ok(Box::new(
+            NumericEquations::with_formalism(model, Formalism::for_explicit_integration(model))?,
+        )),
+        _ => build_engine(model, engine, plugin),
+    }
 }
 
 /// [`build_engine`], building a portable plugin if `portable` (and no `plugin` is given).

@@ -1,7 +1,7 @@
 //! `umsim run SCENARIO.ron [--engine numeric|symbolic] [--plugin FILE] [-o out.csv]
 //! [--set NAME=VALUE]… [--end-time SECONDS]`.
 
-use crate::engine::{Engine, build_engine};
+use crate::engine::{Engine, build_engine, build_run_engine};
 use railmbs_runtime::run::{Interruptible, RunSummary, output_sink, run_scenario_into};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -132,7 +132,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     ) {
         engine.require_mass_matrix("Park's implicit method (the scenario's integrator)")?;
     }
-    let equations = build_engine(&model, engine, args.plugin.as_deref())?;
+    let equations = build_run_engine(&model, engine, args.plugin.as_deref(), &scenario.integrator)?;
     let output = args.output.clone().or_else(|| scenario.output_file.clone());
 
     let bar = progress_bar(args);

@@ -4,7 +4,7 @@
 //! `Train(...)`), changed as `umsim run --set/--end-time` change it (through
 //! [`railmbs_models::Scenario::set_parameter`] and `set_end_time`), plus
 //! macros, initial conditions and the creep law, and run by either engine
-//! ([`railmbs_cli::engine::build_engine`]: the symbolic plugin comes from the
+//! ([`railmbs_cli::engine::build_run_engine`]: the symbolic plugin comes from the
 //! same content-hash cache as the CLI's) into an in-memory [`Table`], with
 //! the GIL released. The progress callback and Ctrl-C are served every
 //! ≥ 100 ms of the run (the runner's progress calls); either stops the run
@@ -14,7 +14,7 @@ use crate::errors;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use railmbs_cli::engine::{Engine, build_engine};
+use railmbs_cli::engine::{Engine, build_run_engine};
 use railmbs_cli::run::TrainEngines;
 use railmbs_models::{AnyScenario, CreepLawSpec, Expr, InitialOverride, TrainScenario};
 use railmbs_runtime::run::{Interruptible, RunError, RunSummary, Table, run_scenario_into};
@@ -536,8 +536,9 @@ impl Scenario {
                 };
                 let (scenario, model, table) = (&**scenario, &*model, &mut table);
                 py.detach(|| {
-                    let equations = build_engine(model, engine, plugin.as_deref())
-                        .map_err(|e| Failure::Engine(e.to_string()))?;
+                    let equations =
+                        build_run_engine(model, engine, plugin.as_deref(), &scenario.integrator)
+                            .map_err(|e| Failure::Engine(e.to_string()))?;
                     let mut sink = Interruptible::new(table, watch.stop.clone());
                     Ok(run_scenario_into(
                         scenario,

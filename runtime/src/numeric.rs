@@ -182,6 +182,29 @@ pub enum Formalism {
     ArticulatedBody,
 }
 
+impl Formalism {
+    /// Coordinates from which the articulated-body q̈ beats composite-body M
+    /// plus its Cholesky solve: on planar chains (`cargo bench -p
+    /// railmbs-runtime --bench formalisms`, one run each, opt-level 1) ABA
+    /// took 19.2 against 23.4 µs at 40 links and 66.6 against 96.7 µs at
+    /// 100 (an earlier session: 29.3 against 31.4 µs at 40), at 30 links
+    /// the two were within the machine's noise of each other across runs.
+    pub const ARTICULATED_BODY_FROM: usize = 40;
+
+    /// The faster formalism for explicit integration (RK4 needs q̈ only,
+    /// never M): articulated-body for open trees (no cut joints) of at least
+    /// [`Formalism::ARTICULATED_BODY_FROM`] coordinates, composite-body
+    /// otherwise. Both give q̈ to rounding (tests/aba.rs); implicit
+    /// integration and the analyses need M and use composite bodies.
+    pub fn for_explicit_integration(model: &Model) -> Formalism {
+        if model.cut_joints.is_empty() && model.coordinates.len() >= Self::ARTICULATED_BODY_FROM {
+            Formalism::ArticulatedBody
+        } else {
+            Formalism::CompositeBody
+        }
+    }
+}
+
 /// The numeric-iterative engine of one model.
 #[derive(Debug, Clone)]
 pub struct NumericEquations {

@@ -383,6 +383,76 @@ fn ctrl_c_stops_the_run_and_says_what_was_kept() {
     assert!(last < 100000.0);
 }
 
+/// `--engine numeric` picks the formalism by size for RK4 (issue 19 item 3,
+/// `Formalism::for_explicit_integration`): a 40-link chain runs with the
+/// articulated-body q̈ (the summary names `numeric-aba`) and gives the same
+/// numbers as an explicit `--engine numeric-aba` run, byte for byte; the
+/// bundled 30-link chain stays composite-body, and so does a Park run of
+/// the 40-link chain (it needs M).
+#[test]
+fn the_numeric_engine_picks_the_formalism_by_size_for_rk4() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("chain40.ron"),
+        railmbs_testkit::model::chain_text(40, false),
+    )
+    .unwrap();
+    let scenario = |name: &str, integrator: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(
+            &path,
+            format!(
+                "Scenario(model: \"chain40.ron\", end_time: 0.05, integrator: {integrator}, \
+                 output: (interval: 0.01))"
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let rk4 = scenario("rk4.ron", "Rk4(step: 0.001)");
+    let park = scenario("park.ron", "Park(rtol: 1e-6, atol: 1e-8, max_step: 0.001)");
+    let engine_line = |o: &std::process::Output| {
+        text(&o.stdout)
+            .lines()
+            .chain(text(&o.stderr).lines())
+            .find(|l| l.starts_with("engine "))
+            .map(|l| l.split_whitespace().last().unwrap_or("").to_string())
+            .unwrap_or_default()
+    };
+    let mut csv = Vec::new();
+    for (file, engine, expect) in [
+        (&rk4, "numeric", "numeric-aba"),
+        (&rk4, "numeric-aba", "numeric-aba"),
+        (&park, "numeric", "numeric"),
+    ] {
+        let out = dir.path().join(format!("{engine}-{expect}.csv"));
+        let o = umsim(&[
+            "run",
+            file.to_str().unwrap(),
+            "--engine",
+            engine,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        assert_eq!(engine_line(&o), expect, "{}", text(&o.stdout));
+        csv.push(std::fs::read(&out).unwrap());
+    }
+    assert_eq!(csv[0], csv[1], "automatic and explicit numeric-aba differ");
+    let o = umsim(&[
+        "run",
+        "models/scenarios/chain30_rk4.ron",
+        "--engine",
+        "numeric",
+        "--end-time",
+        "0.01",
+        "-o",
+        dir.path().join("c30.csv").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(engine_line(&o), "numeric");
+}
+
 /// `--engine numeric-aba` (the articulated-body formalism): an RK4 scenario
 /// runs and gives the composite-body run's numbers to rounding (the two q̈
 /// differ by κ(M) ε; 1e-9 rad over 10 s of the double pendulum); a Park
