@@ -317,6 +317,21 @@ impl ModelSystem {
         }
     }
 
+    /// [`Self::force_outputs`] of the elements `elements` (indices into
+    /// [`Self::forces`]) only, in that order.
+    pub fn force_outputs_of(&self, t: f64, elements: &[usize], out: &mut Vec<f64>) {
+        let ctx = ForceContext {
+            t,
+            bodies: &self.eval.bodies,
+            params: &self.params,
+            states: &self.states,
+            state_rates: &self.state_rates,
+        };
+        for &e in elements {
+            self.forces[e].outputs(&ctx, out);
+        }
+    }
+
     /// Generalized applied forces Q = Q_g + Σ_j Γ_jᵀ F_j (needs kinematics and
     /// Jacobians evaluated) in the coordinates' rows of `out`, and the element
     /// state residuals in the rows after them.

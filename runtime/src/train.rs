@@ -905,7 +905,6 @@ impl RowColumns<TrainSystem> for TrainColumns {
         train: &mut TrainSystem,
         row: &Row,
         values: &mut Vec<f64>,
-        scratch: &mut Vec<f64>,
     ) -> Result<(), RunError> {
         if let Some((arc, offset)) = &self.arc {
             let [s, v] = arc_motion(arc, row.t)?;
@@ -913,7 +912,7 @@ impl RowColumns<TrainSystem> for TrainColumns {
         }
         for (k, cols) in self.vehicles.iter().enumerate() {
             let vehicle_row = row.slice(train.range(k));
-            cols.values(train.vehicle_mut(k), vehicle_row, values, scratch)?;
+            cols.values(train.vehicle_mut(k), vehicle_row, values)?;
         }
         Ok(train.coupler_outputs(row.t, &row.q, &row.v, values)?)
     }

@@ -21,8 +21,8 @@ pub(crate) struct Columns {
     coordinates: bool,
     velocities: bool,
     bodies: Vec<usize>,
-    /// (offset into all force outputs, count) of each selected element.
-    forces: Vec<(usize, usize)>,
+    /// The selected force elements (indices into the system's elements).
+    forces: Vec<usize>,
     /// (body, point in the body's frame) of each accelerometer.
     accelerometers: Vec<(usize, Vector3<f64>)>,
     need_kinematics: bool,
@@ -92,12 +92,6 @@ pub(crate) fn columns(
         }
     }
     let force_names: Vec<String> = model.forces.iter().map(|f| f.name.clone()).collect();
-    let mut offsets = Vec::with_capacity(force_names.len());
-    let mut offset = 0;
-    for f in system.forces() {
-        offsets.push(offset);
-        offset += f.output_names().len();
-    }
     let mut accelerometers = Vec::new();
     for a in &spec.accelerometers {
         let b = select(&body_names, std::slice::from_ref(&a.body), "body", file).map_err(|_| {
@@ -117,7 +111,7 @@ pub(crate) fn columns(
         for s in &names {
             header.push(format!("{}.{s}", force_names[e]));
         }
-        forces.push((offsets[e], names.len()));
+        forces.push(e);
     }
     for a in &spec.accelerometers {
         for c in ["ax[m/s2]", "ay[m/s2]", "az[m/s2]"] {
@@ -137,14 +131,12 @@ pub(crate) fn columns(
 }
 
 impl Columns {
-    /// Appends the values of the columns after `time` and `s[m]` at a state
-    /// (`force_values` is scratch for all force elements' outputs).
+    /// Appends the values of the columns after `time` and `s[m]` at a state.
     pub(crate) fn values(
         &self,
         system: &mut ModelSystem,
         row: RowView,
         values: &mut Vec<f64>,
-        force_values: &mut Vec<f64>,
     ) -> Result<(), RunError> {
         let (t, q, v) = (row.t, row.q, row.v);
         if self.coordinates {
@@ -162,13 +154,8 @@ impl Columns {
                 values.extend(k.velocity.iter());
                 values.extend(k.angular_velocity.iter());
             }
-            let mut all = std::mem::take(force_values);
-            all.clear();
-            system.force_outputs(t, &mut all);
-            for &(offset, count) in &self.forces {
-                values.extend_from_slice(&all[offset..offset + count]);
-            }
-            *force_values = all;
+            // Only the selected elements' outputs are evaluated.
+            system.force_outputs_of(t, &self.forces, values);
         }
         if !self.accelerometers.is_empty() {
             accelerations(system, row, &self.accelerometers, values)?;
@@ -241,12 +228,11 @@ impl RowColumns<ModelSystem> for Columns {
         system: &mut ModelSystem,
         row: &Row,
         values: &mut Vec<f64>,
-        scratch: &mut Vec<f64>,
     ) -> Result<(), RunError> {
         if let Some(arc) = &self.arc {
             values.extend(arc_motion(arc, row.t)?);
         }
-        self.values(system, row.slice(0..row.q.len()), values, scratch)
+        self.values(system, row.slice(0..row.q.len()), values)
     }
 }
 

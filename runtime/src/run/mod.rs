@@ -186,15 +186,9 @@ pub(crate) trait RowColumns<S> {
     /// Column names, the first `time`.
     fn header(&self) -> &[String];
 
-    /// Appends the values after `time` of the row (`scratch` is a reusable
-    /// buffer). May evaluate `system` at the row's state.
-    fn values(
-        &self,
-        system: &mut S,
-        row: &Row,
-        values: &mut Vec<f64>,
-        scratch: &mut Vec<f64>,
-    ) -> Result<(), RunError>;
+    /// Appends the values after `time` of the row. May evaluate `system`
+    /// at the row's state.
+    fn values(&self, system: &mut S, row: &Row, values: &mut Vec<f64>) -> Result<(), RunError>;
 }
 
 /// What the runner needs of a system besides integrating it: the wheel
@@ -301,7 +295,6 @@ struct Rows {
     steps_since_row: usize,
     pending: PendingRows,
     values: Vec<f64>,
-    scratch: Vec<f64>,
     written: usize,
     /// The first failure (evaluating or writing a row); the run stops.
     failure: Option<RunError>,
@@ -326,7 +319,7 @@ impl Rows {
             self.values.clear();
             self.values.push(row.t);
             let written = columns
-                .values(system, &row, &mut self.values, &mut self.scratch)
+                .values(system, &row, &mut self.values)
                 .and_then(|()| sink.row(&self.values));
             match written {
                 Ok(()) => self.written += 1,
@@ -379,7 +372,6 @@ impl Runner<'_> {
             steps_since_row: 0,
             pending: PendingRows::new(),
             values: Vec::new(),
-            scratch: Vec::new(),
             written: 0,
             failure: None,
             reducer: AssessmentReducer::new(),

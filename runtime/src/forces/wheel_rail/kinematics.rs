@@ -263,8 +263,15 @@ impl WheelRailContact {
         }
         // (the cosine as `point_kinematics` takes it, bit for bit)
         let (_, cd) = c.contact_angle.sin_cos();
-        // N ∝ approach^{3/2}: the load scales by `weight`.
-        let approach = penetration * weight.powf(2.0 / 3.0) * cd;
+        // N ∝ approach^{3/2}: the load scales by `weight`. (Away from a
+        // region boundary the weight is 1, and 1^(2/3) = 1 exactly: the
+        // power is skipped there, bit for bit the same.)
+        let scale = if weight == 1.0 {
+            1.0
+        } else {
+            weight.powf(2.0 / 3.0)
+        };
+        let approach = penetration * scale * cd;
         // Hertz shape from the curvatures at the contact.
         let (curv_a, curv_b) = wheel_rail_curvatures(
             1.0 / c.wheel_longitudinal_curvature.max(1e-6),

@@ -109,7 +109,9 @@ impl WheelRailContact {
             ctx.bodies[self.wheel_body(1)],
         ];
         let Ok(mut last) = self.last.lock() else {
-            return Ok(f(&self.solve_new(ctx)?));
+            let mut state = WheelsetState::default();
+            self.solve_into(ctx, &mut state)?;
+            return Ok(f(&state));
         };
         if let Some((t, k, state)) = last.as_ref()
             && *t == ctx.t
@@ -117,13 +119,18 @@ impl WheelRailContact {
         {
             return Ok(f(state));
         }
-        let state = self.solve_new(ctx)?;
-        let (_, _, state) = last.insert((ctx.t, body, state));
+        // Solved in the kept slot itself (no copy of the state), marked as
+        // solved for no time (NaN) until the solve has succeeded.
+        let (t, k, state) = last.get_or_insert_with(|| (f64::NAN, body, WheelsetState::default()));
+        *t = f64::NAN;
+        self.solve_into(ctx, state)?;
+        (*t, *k) = (ctx.t, body);
         Ok(f(state))
     }
 
-    /// Solves both wheels' contacts at the context's state.
-    fn solve_new(&self, ctx: &ForceContext) -> Result<WheelsetState, SimError> {
+    /// Solves both wheels' contacts at the context's state into `state`
+    /// (whatever it held before).
+    fn solve_into(&self, ctx: &ForceContext, state: &mut WheelsetState) -> Result<(), SimError> {
         let Some(b) = &self.bound else {
             return Err(self.err(
                 "no track: a wheel–rail element needs the scenario's track (`track: (file: …)`)",
@@ -131,14 +138,14 @@ impl WheelRailContact {
         };
         let t = ctx.t;
         let sides = self.sides(ctx, b)?;
-        let mut state = WheelsetState {
-            track_axes: sides[0].axes,
-            ..WheelsetState::default()
-        };
+        state.count = [0; 2];
+        state.track_axes = sides[0].axes;
+        state.rail_d = Default::default();
+        state.rail_creep = Default::default();
         match self.c.rail {
             None if self.c.non_elliptic.is_some() => {
                 for geo in &sides {
-                    self.solve_non_elliptic_side(geo, &mut state)?;
+                    self.solve_non_elliptic_side(geo, state)?;
                 }
             }
             None => {
@@ -208,11 +215,11 @@ impl WheelRailContact {
                 let (h, d_prev, creep) = self.rail_reference(t);
                 for (side, geo) in sides.iter().enumerate() {
                     let start = (h, d_prev[side], &creep[side]);
-                    self.solve_elastic_side(geo, &support, start, &mut state)?;
+                    self.solve_elastic_side(geo, &support, start, state)?;
                 }
             }
         }
-        Ok(state)
+        Ok(())
     }
 
     /// The contact patch for the creep law: semi-axes `a`, `b` (m), normal
