@@ -70,6 +70,11 @@ pub struct EquilibriumSettings {
     pub max_step: f64,
     /// Largest relative change of a rate in one Newton step.
     pub max_rate_change: f64,
+    /// Smaller limits than `max_step` for particular positions: (system
+    /// coordinate index, largest change in one Newton step, m or rad). A
+    /// wheelset's lateral shift, say, kept from crossing its flangeway in
+    /// one step while the car body moves freely.
+    pub step_limits: Vec<(usize, f64)>,
 }
 
 impl Default for EquilibriumSettings {
@@ -79,6 +84,7 @@ impl Default for EquilibriumSettings {
             force_tolerance: None,
             max_step: 0.1,
             max_rate_change: 0.1,
+            step_limits: Vec::new(),
         }
     }
 }
@@ -527,7 +533,11 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
         let mut cap: f64 = 1.0;
         for (k, &(i, role)) in unknowns.map.iter().enumerate() {
             let limit = match role {
-                Role::Position => settings.max_step,
+                Role::Position => settings
+                    .step_limits
+                    .iter()
+                    .filter(|&&(j, _)| j == i)
+                    .fold(settings.max_step, |a, &(_, l)| a.min(l)),
                 _ => settings.max_rate_change * v[i].abs().max(1.0),
             };
             if dx[k].abs() > limit {
