@@ -192,7 +192,10 @@ pub fn direct_settings() -> EquilibriumSettings {
 /// (no step across a flangeway), the other positions to the default 0.1 m
 /// (the car body's lean in the cant and its lateral and vertical
 /// suspension deflections, 10–40 mm for Vehicle 1, which the guess leaves
-/// out, in a step or two).
+/// out, in a step or two), and chord steps
+/// ([`EquilibriumSettings::chord_steps`]: Vehicle 1 in the 150 m curve
+/// takes 11 iterations with 6 fresh Jacobians instead of 9 with 9, about
+/// 7 % less time in one criterion run).
 pub fn guessed_settings(model: &Model, coordinates: &[CoordinateInfo]) -> EquilibriumSettings {
     let step_limits = model
         .forces
@@ -209,6 +212,7 @@ pub fn guessed_settings(model: &Model, coordinates: &[CoordinateInfo]) -> Equili
     EquilibriumSettings {
         max_iterations: DIRECT_ITERATIONS,
         step_limits,
+        chord_steps: true,
         ..EquilibriumSettings::default()
     }
 }
@@ -633,7 +637,7 @@ pub fn first_guess(model: &Model, built: &ScenarioSystem, curve: &Curve) -> Vec<
             })
     };
     // Units: a carrier and its wheelsets (with their rigid contact functions).
-    let mut units: Vec<(usize, Vec<(usize, f64, Vec<RigidContact>)>)> = Vec::new();
+    let mut units: Vec<(usize, Vec<UnitWheelset>)> = Vec::new();
     for &(w, element) in &wheelsets {
         if placeable[w].is_none() {
             continue;
@@ -772,6 +776,10 @@ pub fn first_guess(model: &Model, built: &ScenarioSystem, curve: &Curve) -> Vec<
     }
     overrides
 }
+
+/// A wheelset of a unit in [`first_guess`]: its body, nominal rolling
+/// radius (m) and rigid contact functions.
+type UnitWheelset = (usize, f64, Vec<RigidContact>);
 
 /// The axle height above nominal (m) and roll (rad) of the rigid contact
 /// functions `rigid` at the shift `y` (m), interpolated linearly (held at
