@@ -559,7 +559,8 @@ fn pure_rolling_shift(table: &[(f64, f64)], target: f64) -> (f64, bool) {
 ///   Δr = 2 r₀ b / R for a = 0; the rigid bogie as in Boocock 1969, J.
 ///   Mech. Eng. Sci. 11), from the contact table's rigid functions
 ///   ([`ForceElement::rigid_contact`](crate::forces::ForceElement::rigid_contact),
-///   b = 0.75 m), capped at the flange ([`pure_rolling_shift`]);
+///   b = 0.75 m), capped at the flange (the start of the steepest rise of
+///   |Δr| on that side: 6.1 mm for S1002 on UIC60 1:40);
 /// - where that caps the leading wheelset at its flange (Vehicle 1 below
 ///   about 540 m), the trailing ones at the inner rail's flange: the rigid
 ///   bogie yawed across its flangeway, as Vehicle 1 runs in the 150 m
