@@ -15,11 +15,12 @@
 //!   speeds from 10 to 69 m/s (`umsim modes --speed 10:69:1`), each from
 //!   its own steady state, contact tables built once;
 //! - `curving/cold`: the 150 m curve with 100 mm cant of track case 1 at
-//!   4.4 m/s (`vehicle1_tc1.ron`) from the model's initial state
-//!   (wheelsets centred), everything but the contact tables included;
+//!   4.4 m/s (`vehicle1_tc1.ron`) without a guess (the direct solve from
+//!   `first_guess`, the rigid vehicle in the curve), everything but the
+//!   contact tables included;
 //!   `curving/warm`: the same curve at 4.4 m/s from the solution at
 //!   4.0 m/s (a speed sweep's next point); `curving/wide`: a 3000 m curve
-//!   without cant at 30 m/s from the model's initial state.
+//!   without cant at 30 m/s without a guess.
 //!
 //! Before timing, one solve of each prints its own figures (Newton
 //! iterations, seconds). Run: `cargo bench -p railmbs-runtime --bench

@@ -70,6 +70,19 @@ pub struct EquilibriumSettings {
     pub max_step: f64,
     /// Largest relative change of a rate in one Newton step.
     pub max_rate_change: f64,
+    /// Smaller limits than `max_step` for particular positions: (system
+    /// coordinate index, largest change in one Newton step, m or rad). A
+    /// wheelset's lateral shift, say, kept from crossing its flangeway in
+    /// one step while the car body moves freely.
+    pub step_limits: Vec<(usize, f64)>,
+    /// Chord steps: after a full Newton step that at least halved |r|₂,
+    /// the next step reuses that step's Jacobian instead of a fresh
+    /// difference Jacobian (one evaluation of the model instead of one per
+    /// unknown); a chord step that does not decrease |r|₂ by the line
+    /// search's criterion at full length is dropped and taken again with
+    /// a fresh Jacobian. Off by default (the steady states of runs and
+    /// analyses are found with fresh Jacobians only).
+    pub chord_steps: bool,
 }
 
 impl Default for EquilibriumSettings {
@@ -79,6 +92,8 @@ impl Default for EquilibriumSettings {
             force_tolerance: None,
             max_step: 0.1,
             max_rate_change: 0.1,
+            step_limits: Vec::new(),
+            chord_steps: false,
         }
     }
 }
@@ -446,6 +461,9 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
         forces <= tolerance && gaps <= 1e-12
     };
     let mut iterations = 0;
+    // The last fresh Jacobian, when the step taken with it was full and at
+    // least halved |r|₂ (chord steps).
+    let mut chord: Option<DMatrix<f64>> = None;
     while !converged(&r) {
         if iterations == settings.max_iterations {
             if let Some(e) = coasting(system, &mut eval, &unknowns, names, (&q, &v, &lambda), &r)? {
@@ -463,11 +481,15 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
             });
         }
         iterations += 1;
+        let chord_step = chord.is_some();
         // Forward-difference Jacobian of r over the unknowns; the
         // multipliers' columns are Gᵀ exactly.
         let m = unknowns.len();
-        let mut jac = DMatrix::zeros(m, m);
+        let mut jac = chord.take().unwrap_or_else(|| DMatrix::zeros(m, m));
         for (k, &(i, role)) in unknowns.map.iter().enumerate() {
+            if chord_step {
+                break;
+            }
             let slot = match role {
                 Role::Position => &mut q[i],
                 _ => &mut v[i],
@@ -485,7 +507,7 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
             }
             jac.set_column(k, &((rp - &r) / h));
         }
-        if nc > 0 {
+        if nc > 0 && !chord_step {
             eval.constraints(system, &q)?;
             for c in 0..nc {
                 for (k, &i) in unknowns.rows.iter().enumerate() {
@@ -527,7 +549,11 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
         let mut cap: f64 = 1.0;
         for (k, &(i, role)) in unknowns.map.iter().enumerate() {
             let limit = match role {
-                Role::Position => settings.max_step,
+                Role::Position => settings
+                    .step_limits
+                    .iter()
+                    .filter(|&&(j, _)| j == i)
+                    .fold(settings.max_step, |a, &(_, l)| a.min(l)),
                 _ => settings.max_rate_change * v[i].abs().max(1.0),
             };
             if dx[k].abs() > limit {
@@ -537,6 +563,22 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
         // Backtracking line search on |r|₂.
         let norm = r.norm();
         let mut alpha = cap;
+        if chord_step {
+            // Full length or not at all.
+            let xt: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, d)| a + cap * d).collect();
+            unknowns.scatter(&xt, &mut q, &mut v, &mut lambda);
+            if let Ok((rt, ft)) = residual(system, &mut eval, &unknowns, (&q, &v, &lambda))
+                && rt.norm() <= (1.0 - 1e-4 * cap) * norm
+            {
+                if cap == 1.0 && rt.norm() <= 0.5 * norm {
+                    chord = Some(jac);
+                }
+                (x, r, full) = (xt, rt, ft);
+                continue;
+            }
+            unknowns.scatter(&x, &mut q, &mut v, &mut lambda);
+            continue;
+        }
         let trial = loop {
             let xt: Vec<f64> = x
                 .iter()
@@ -554,6 +596,9 @@ fn solve_with_roles_at<S: MechanicalSystem + ?Sized>(
             }
             alpha *= 0.5;
         };
+        if settings.chord_steps && alpha == 1.0 && trial.1.norm() <= 0.5 * norm {
+            chord = Some(jac);
+        }
         (x, r, full) = trial;
     }
     unknowns.scatter(&x, &mut q, &mut v, &mut lambda);

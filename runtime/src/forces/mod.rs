@@ -35,6 +35,7 @@ pub use jacobian::{ForceJacobian, JacobianScratch, PairMatrix, point_twist_map};
 use crate::equations::BodyKinematics;
 use crate::system::SimError;
 use nalgebra::Vector3;
+use railmbs_wheelrail::geometry::RigidContact;
 
 use railmbs_models::{ForceKind, Model};
 
@@ -137,6 +138,17 @@ pub trait ForceElement: std::fmt::Debug + Send {
     /// of the run ([`crate::run::assessment`]); `None` for elements that are
     /// not wheel–rail contacts.
     fn assessment_loads(&self, _ctx: &ForceContext) -> Option<WheelLoads> {
+        None
+    }
+    /// The rigid contact geometry of a wheel–rail element bound to its
+    /// track, for estimates such as the first guess of quasi-static curving
+    /// ([`crate::analysis::curving`]): the nominal rolling radius r₀ (m) and
+    /// the contact table's rigid contact functions (roll, axle height and
+    /// both wheels' contacts at each lateral shift y of the wheelset, m,
+    /// positive to the left, in increasing y; see
+    /// [`RigidContact::rolling_radius_difference`]). `None` for other
+    /// elements and before the track is bound.
+    fn rigid_contact(&self) -> Option<(f64, Vec<RigidContact>)> {
         None
     }
     /// Number of first-order state variables the element adds to the system

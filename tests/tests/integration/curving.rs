@@ -2,10 +2,14 @@
 //! time-domain run through the same curve: Manchester Vehicle 1 in the
 //! 150 m right curve with 100 mm cant of track case 1 at 4.4 m/s.
 
+use railmbs_models::InitialStateKind;
 use railmbs_models::{Model, Scenario, load_model, load_scenario};
-use railmbs_runtime::analysis::curving::{Curve, Curving, curving};
+use railmbs_runtime::analysis::curving::{
+    Curve, Curving, curve_scenario, curving, curving_by_continuation, direct_settings, first_guess,
+};
 use railmbs_runtime::forces::ContactTableCache;
 use railmbs_runtime::run::RunError;
+use railmbs_runtime::run::scenario::scenario_system_with;
 use railmbs_runtime::{Equations, NumericEquations};
 use railmbs_testkit::*;
 
@@ -209,5 +213,87 @@ fn a_bad_curve_is_refused_with_a_message_naming_it() {
             .to_string();
         assert!(err.contains(words), "{err}");
         assert!(err.contains("vehicle1_tc1.ron"), "{err}");
+    }
+}
+
+/// The direct solve from the rigid vehicle's position in the curve
+/// (`first_guess`, the default cold path) reaches the same steady state as
+/// the continuation in curvature from the centred state, in the 150 m
+/// curve of track case 1 and in a tighter 120 m one, both with 100 mm cant
+/// at 4.4 m/s. Both solutions leave residual forces below the Newton
+/// tolerance τ (1.9e-2 N for Vehicle 1); the softest restraint of a solved
+/// position is the car body's lateral one on its four secondary springs,
+/// k = 4 × 160 kN/m, so two such states differ by at most 2τ/k = 6.0e-8 m
+/// (or rad) in every coordinate. The final solve starts at `first_guess`'s
+/// values (the fast path, not the continuation, gave the solution).
+#[test]
+fn the_direct_cold_solve_equals_the_continuation_in_curvature() {
+    let (s, model) = vehicle1_tc1();
+    let tables = ContactTableCache::new();
+    let mut engine =
+        || -> Result<Box<dyn Equations>, RunError> { Ok(Box::new(NumericEquations::new(&model))) };
+    for radius in [-150.0, -120.0] {
+        let curve = Curve {
+            radius,
+            cant: 0.1,
+            speed: 4.4,
+        };
+        let direct = curving(&s, &model, &mut engine, &tables, &curve).unwrap();
+        let reference = curving_by_continuation(&s, &model, &mut engine, &tables, &curve).unwrap();
+        let tolerance = direct.equilibrium.tolerance;
+        assert!(
+            direct.equilibrium.residual <= tolerance,
+            "{}",
+            direct.equilibrium.residual
+        );
+        assert!(reference.equilibrium.residual <= tolerance);
+        let bound = 2.0 * tolerance / (4.0 * 160e3);
+        for (i, c) in direct
+            .coordinates
+            .iter()
+            .enumerate()
+            .take(model.coordinates.len())
+        {
+            if direct.equilibrium.roles[i] != railmbs_runtime::analysis::equilibrium::Role::Position
+            {
+                continue;
+            }
+            let (a, b) = (direct.equilibrium.q[i], reference.equilibrium.q[i]);
+            assert!(
+                (a - b).abs() <= bound,
+                "R = {radius} m, {}: {a} against {b}",
+                c.name
+            );
+        }
+        // The fast path: the final solve started from the guess.
+        let mut given = curve_scenario(&s, &model, &curve).unwrap();
+        given.initial_kind = InitialStateKind::Given;
+        let built = scenario_system_with(
+            &given,
+            &model,
+            engine().unwrap(),
+            &tables,
+            &direct_settings(),
+        )
+        .unwrap();
+        let guess = first_guess(&model, &built, &curve);
+        assert!(guess.len() >= 4 * 4 + 2 * 3, "{guess:?}");
+        for g in &guess {
+            let i = direct
+                .coordinates
+                .iter()
+                .position(|c| c.name == g.coordinate)
+                .unwrap();
+            assert_eq!(
+                direct.equilibrium.q_start[i],
+                g.value.unwrap(),
+                "{}",
+                g.coordinate
+            );
+        }
+        // The leading wheelsets at the outer (left) flange, the trailing
+        // ones towards the inner rail, as the guess put them.
+        assert!(direct.wheelsets[0].lateral.unwrap() > 5e-3);
+        assert!(direct.wheelsets[1].lateral.unwrap() < -5e-3);
     }
 }

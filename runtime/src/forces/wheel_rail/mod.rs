@@ -253,6 +253,22 @@ impl ForceElement for WheelRailContact {
         true
     }
 
+    fn rigid_contact(&self) -> Option<(f64, Vec<railmbs_wheelrail::geometry::RigidContact>)> {
+        let b = self.bound.as_ref()?;
+        // With a conicity override the table is looked up at s·y.
+        let rigid = b.contact.table.rigid_functions();
+        Some((
+            b.contact.nominal_radius,
+            rigid
+                .iter()
+                .map(|r| railmbs_wheelrail::geometry::RigidContact {
+                    y: r.y / b.shift_scale,
+                    ..*r
+                })
+                .collect(),
+        ))
+    }
+
     fn bind_track(&mut self, binding: &TrackBinding) -> Result<(), SimError> {
         self.bound = Some(self.bind(binding)?);
         *self.frame_at.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
