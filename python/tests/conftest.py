@@ -64,3 +64,18 @@ def run_cli(umsim, tmp_path):
         return proc.stdout, header, cols
 
     return run
+
+
+@pytest.fixture
+def python_sigint_handler():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, then
+    the previous one: a process started in the background of a shell
+    without job control inherits SIGINT ignored, and Python then keeps it
+    ignored, so a Ctrl-C test would test nothing there."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -48,7 +48,7 @@ def test_an_exception_in_the_callback_stops_the_run_and_is_reraised():
     assert len(calls) == 1 and calls[0] < 1e4
 
 
-def test_ctrl_c_stops_the_run_with_keyboard_interrupt():
+def test_ctrl_c_stops_the_run_with_keyboard_interrupt(python_sigint_handler):
     """SIGINT while the run is in Rust (GIL released): the next progress
     tick runs Python's handler and the run stops with KeyboardInterrupt.
     The signal is sent from another thread once the run is under way (its

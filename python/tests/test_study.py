@@ -268,7 +268,7 @@ def test_a_table_of_another_study_is_refused(study_dir, tmp_path):
         rs.run(other, tmp_path, progress=False)
 
 
-def test_ctrl_c_stops_the_local_pool_and_the_study_resumes(tmp_path):
+def test_ctrl_c_stops_the_local_pool_and_the_study_resumes(tmp_path, python_sigint_handler):
     path = write_slow(tmp_path)
     # SIGINT (Ctrl-C) when the first case has finished and others run (each
     # ~1 s): the running cases stop unrecorded, the finished ones stay. The
