@@ -387,22 +387,8 @@ impl MechanicalSystem for ModelSystem {
         mass: &mut DMatrix<f64>,
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
-        if !self.forces_initialized {
-            self.accept_forces(t, q, v)?;
-        }
-        let (q, v) = self.take_states(q, v);
-        self.equations
-            .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
-        self.applied_forces(t, force)?;
+        self.evaluate_forces(t, q, v, force)?;
         let n = self.n_coordinates;
-        // Slices, not nalgebra's generic views: a plain loop and a memcpy
-        // at any optimization level (this runs once per RK4 stage).
-        for (f, b) in force.as_mut_slice()[..n]
-            .iter_mut()
-            .zip(self.eval.bias.as_slice())
-        {
-            *f -= b;
-        }
         if self.states.is_empty() {
             mass.as_mut_slice()
                 .copy_from_slice(self.eval.mass.as_slice());
@@ -545,20 +531,7 @@ impl MechanicalSystem for ModelSystem {
         mass: &mut BlockMatrix,
         force: &mut DVector<f64>,
     ) -> Result<(), SimError> {
-        if !self.forces_initialized {
-            self.accept_forces(t, q, v)?;
-        }
-        let (q, v) = self.take_states(q, v);
-        self.equations
-            .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
-        self.applied_forces(t, force)?;
-        for (f, b) in force
-            .as_mut_slice()
-            .iter_mut()
-            .zip(self.eval.bias.as_slice())
-        {
-            *f -= b;
-        }
+        self.evaluate_forces(t, q, v, force)?;
         mass.copy_from_dense(&self.eval.mass);
         Ok(())
     }
@@ -589,6 +562,37 @@ impl MechanicalSystem for ModelSystem {
 }
 
 impl ModelSystem {
+    /// The evaluation behind [`MechanicalSystem::dynamics`] and its block
+    /// form: the force elements' states set at the first call (as if the
+    /// initial state had been accepted), the engine's M, k and Q_g at (t, q,
+    /// q̇) in `self.eval`, and `force` = Q − k (element state rates after
+    /// the coordinates' rows).
+    fn evaluate_forces(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        force: &mut DVector<f64>,
+    ) -> Result<(), SimError> {
+        if !self.forces_initialized {
+            self.accept_forces(t, q, v)?;
+        }
+        let (q, v) = self.take_states(q, v);
+        self.equations
+            .evaluate(t, q, v, self.dynamics_parts, &mut self.eval)?;
+        self.applied_forces(t, force)?;
+        let n = self.n_coordinates;
+        // Slices, not nalgebra's generic views: a plain loop and a memcpy
+        // at any optimization level (this runs once per RK4 stage).
+        for (f, b) in force.as_mut_slice()[..n]
+            .iter_mut()
+            .zip(self.eval.bias.as_slice())
+        {
+            *f -= b;
+        }
+        Ok(())
+    }
+
     /// Tells the force elements that (t, q, q̇) is accepted (their states
     /// update); fails when the kinematics there cannot be evaluated.
     fn accept_forces(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SimError> {
