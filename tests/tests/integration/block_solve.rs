@@ -200,26 +200,15 @@ fn vehicle1_runs_the_same_with_block_and_dense_solver() {
             Box::new(NumericEquations::new(&model)),
         ));
     }
-    let (a, b) = (&tables[0], &tables[1]);
-    assert_eq!(a.header, b.header);
-    assert_eq!(a.rows.len(), b.rows.len());
-    let (mut worst, mut which, mut differs) = (0.0_f64, String::new(), false);
-    for (ra, rb) in a.rows.iter().zip(&b.rows) {
-        for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
-            differs |= x != y;
-            if a.header[k].ends_with(']') || a.header[k] == "time" {
-                continue;
-            }
-            let e = (x - y).abs() / (1e-6 + 1e-4 * x.abs());
-            if e > worst {
-                (worst, which) = (e, a.header[k].clone());
-            }
-        }
-    }
-    eprintln!("largest difference {worst} tolerances ({which})");
+    let d = tables[0].coordinate_difference(&tables[1], 1e-4, 1e-6);
     assert!(
-        differs,
+        d.differs,
         "the block run should round differently from the dense one"
     );
-    assert!(worst < 2.0, "{which}: difference {worst} tolerances");
+    assert!(
+        d.tolerances < 2.0,
+        "{}: difference {} tolerances",
+        d.column,
+        d.tolerances
+    );
 }

@@ -457,20 +457,13 @@ fn symbolic_and_numeric_engines_agree_on_a_train() {
     // Coordinates (m, rad) against the integrator's tolerances (rtol 1e-4,
     // atol 1e-6): the error of each engine's run is estimated to those; the
     // engines agree to rounding on the equations.
-    let (mut worst, mut which) = (0.0_f64, String::new());
-    for (ra, rb) in a.rows.iter().zip(&b.rows) {
-        for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
-            if a.header[k].ends_with(']') || a.header[k] == "time" {
-                continue;
-            }
-            let e = (x - y).abs() / (1e-6 + 1e-4 * x.abs());
-            if e > worst {
-                (worst, which) = (e, a.header[k].clone());
-            }
-        }
-    }
-    eprintln!("largest difference {worst} tolerances ({which})");
-    assert!(worst < 1.0, "{which}: difference {worst} tolerances");
+    let d = a.coordinate_difference(&b, 1e-4, 1e-6);
+    assert!(
+        d.tolerances < 1.0,
+        "{}: difference {} tolerances",
+        d.column,
+        d.tolerances
+    );
 }
 
 /// Mistakes in a train file are reported with the file, the element and the
@@ -609,24 +602,15 @@ fn block_and_dense_solvers_run_the_same_train() {
     assert_eq!(a.header, b.header);
     let y = a.col("Coach1.body.y[m]");
     assert!(y.iter().fold(0.0_f64, |m, x| m.max(x.abs())) > 1e-4);
-    let (mut worst, mut which) = (0.0_f64, String::new());
-    let mut differs = false;
-    for (ra, rb) in a.rows.iter().zip(&b.rows) {
-        for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
-            differs |= x != y;
-            if a.header[k].ends_with(']') || a.header[k] == "time" {
-                continue;
-            }
-            let e = (x - y).abs() / (1e-6 + 1e-4 * x.abs());
-            if e > worst {
-                (worst, which) = (e, a.header[k].clone());
-            }
-        }
-    }
-    eprintln!("largest difference {worst} tolerances ({which})");
+    let d = a.coordinate_difference(b, 1e-4, 1e-6);
     assert!(
-        differs,
+        d.differs,
         "the block run should round differently from the dense one"
     );
-    assert!(worst < 1.0, "{which}: difference {worst} tolerances");
+    assert!(
+        d.tolerances < 1.0,
+        "{}: difference {} tolerances",
+        d.column,
+        d.tolerances
+    );
 }
