@@ -269,7 +269,7 @@ impl Track {
         let roll_rate = up / c;
         let roll_rate2 = u * up * up / (c2 * c);
         let s = s.clamp(0.0, self.alignment.length());
-        let (widening, _) = self.gauge_widening.value_slope(s);
+        let gauge = self.gauge(s)?;
         Ok(TrackPoint {
             s,
             plan,
@@ -280,8 +280,18 @@ impl Track {
             roll,
             roll_rate,
             roll_rate2,
-            gauge: self.nominal_gauge + widening,
+            gauge,
         })
+    }
+
+    /// The gauge at arc position `s` (m), in m: [`TrackPoint::gauge`] of
+    /// [`Track::point`] without the rest of the point (the contact asks for
+    /// it at every wheelset and evaluation), with the same errors for an `s`
+    /// off the track.
+    pub fn gauge(&self, s: f64) -> Result<f64, TrackError> {
+        let s = self.alignment.check_s(s)?;
+        let (widening, _) = self.gauge_widening.value_slope(s);
+        Ok(self.nominal_gauge + widening)
     }
 
     /// The track-following frame at arc position `s` (m) moving with `s_dot`

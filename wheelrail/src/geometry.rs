@@ -1318,84 +1318,105 @@ impl ContactTable {
     /// load is then shared by two patches where in reality one conformal
     /// patch spans both.
     pub fn lookup_regions(&self, y: f64, roll: f64) -> Result<[[Contact; 2]; 2], GeometryError> {
+        Ok([
+            self.lookup_regions_of(0, y, roll)?,
+            self.lookup_regions_of(1, y, roll)?,
+        ])
+    }
+
+    /// One wheel's `[slot]` of [`Self::lookup_regions`] (`side` 0 left,
+    /// 1 right), the same numbers, with only that wheel's lateral shift
+    /// checked against the table: the contact looks each wheel up at its
+    /// own rail's position.
+    pub fn lookup_regions_of(
+        &self,
+        side: usize,
+        y: f64,
+        roll: f64,
+    ) -> Result<[Contact; 2], GeometryError> {
         if !(y.is_finite() && roll.is_finite()) {
             return Err(invalid(
                 "wheelset position",
                 format!("lateral shift {y} and roll {roll} must be finite"),
             ));
         }
-        let mut out = [[Contact::default(); 2]; 2];
-        for (side, sign) in [(0, 1.0), (1, -1.0)] {
-            let (ys, ps) = (sign * y, sign * roll);
-            let w = ys + ps.sin() * self.radius[side];
-            let (i, tw) = Self::locate("lateral shift", w, self.w0, self.dy, self.nw)?;
-            let (j, tr) = Self::locate("roll", ps, self.r0, self.dr, self.nr)?;
-            let j1 = (j + 1).min(self.nr - 1);
-            let i1 = (i + 1).min(self.nw - 1);
-            let corners = [
-                (i, j, (1.0 - tw) * (1.0 - tr)),
-                (i1, j, tw * (1.0 - tr)),
-                (i, j1, (1.0 - tw) * tr),
-                (i1, j1, tw * tr),
-            ];
-            let nodes = &self.regions[side];
-            // In (w, roll) the gap is nearly linear in roll (its rigid-body
-            // part sin φ·ξ + (cos φ − 1)·ζ: with ξ ≈ 0.75 m, ζ ≈ −0.46 m the
-            // error of linear interpolation over a 2 mrad cell is below 1 µm).
-            let node_gap = |ci: usize, cj: usize, slot: usize| nodes[ci * self.nr + cj][slot].gap;
-            for slot in 0..2 {
-                // The gap along w by cubic Hermite interpolation (slopes by
-                // central differences), linear in roll: continuous with a
-                // continuous slope, so the contact angle taken from the slope
-                // below is continuous too and is the gradient of the gap — the
-                // normal force stays (nearly) conservative even across a jump
-                // of the contact point, where the profile's own contact angle
-                // would switch within one cell.
-                let mut gap = 0.0;
-                let mut slope = 0.0;
-                for (cj, wr) in [(j, 1.0 - tr), (j1, tr)] {
-                    if wr == 0.0 {
-                        continue;
-                    }
-                    let g = |k: isize| {
-                        let k = k.clamp(0, self.nw as isize - 1) as usize;
-                        node_gap(k, cj, slot)
-                    };
-                    let (a, b) = (i as isize, i1 as isize);
-                    let (p0, p1) = (g(a), g(b));
-                    let m0 = 0.5 * (p1 - g(a - 1));
-                    let m1 = 0.5 * (g(b + 1) - p0);
-                    let t = tw;
-                    let (t2, t3) = (t * t, t * t * t);
-                    gap += wr
-                        * ((2.0 * t3 - 3.0 * t2 + 1.0) * p0
-                            + (t3 - 2.0 * t2 + t) * m0
-                            + (-2.0 * t3 + 3.0 * t2) * p1
-                            + (t3 - t2) * m1);
-                    slope += wr
-                        * ((6.0 * t2 - 6.0 * t) * p0
-                            + (3.0 * t2 - 4.0 * t + 1.0) * m0
-                            + (-6.0 * t2 + 6.0 * t) * p1
-                            + (3.0 * t2 - 2.0 * t) * m1)
-                        / self.dy;
+        if side > 1 {
+            return Err(invalid(
+                "wheel side",
+                format!("{side}: 0 is the left wheel, 1 the right"),
+            ));
+        }
+        let mut out = [Contact::default(); 2];
+        let sign = if side == 0 { 1.0 } else { -1.0 };
+        let (ys, ps) = (sign * y, sign * roll);
+        let w = ys + ps.sin() * self.radius[side];
+        let (i, tw) = Self::locate("lateral shift", w, self.w0, self.dy, self.nw)?;
+        let (j, tr) = Self::locate("roll", ps, self.r0, self.dr, self.nr)?;
+        let j1 = (j + 1).min(self.nr - 1);
+        let i1 = (i + 1).min(self.nw - 1);
+        let corners = [
+            (i, j, (1.0 - tw) * (1.0 - tr)),
+            (i1, j, tw * (1.0 - tr)),
+            (i, j1, (1.0 - tw) * tr),
+            (i1, j1, tw * tr),
+        ];
+        let nodes = &self.regions[side];
+        // In (w, roll) the gap is nearly linear in roll (its rigid-body
+        // part sin φ·ξ + (cos φ − 1)·ζ: with ξ ≈ 0.75 m, ζ ≈ −0.46 m the
+        // error of linear interpolation over a 2 mrad cell is below 1 µm).
+        let node_gap = |ci: usize, cj: usize, slot: usize| nodes[ci * self.nr + cj][slot].gap;
+        for slot in 0..2 {
+            // The gap along w by cubic Hermite interpolation (slopes by
+            // central differences), linear in roll: continuous with a
+            // continuous slope, so the contact angle taken from the slope
+            // below is continuous too and is the gradient of the gap — the
+            // normal force stays (nearly) conservative even across a jump
+            // of the contact point, where the profile's own contact angle
+            // would switch within one cell.
+            let mut gap = 0.0;
+            let mut slope = 0.0;
+            for (cj, wr) in [(j, 1.0 - tr), (j1, tr)] {
+                if wr == 0.0 {
+                    continue;
                 }
-                let mut acc = [0.0; 14];
-                for &(ci, cj, wt) in &corners {
-                    if wt == 0.0 {
-                        continue;
-                    }
-                    let v = nodes[ci * self.nr + cj][slot].values();
-                    for (a, v) in acc.iter_mut().zip(v) {
-                        *a += wt * v;
-                    }
-                }
-                let mut c = Contact::from_values(acc);
-                c.gap = gap;
-                // ∂gap/∂y_s = −tan δ (moving the wheel outwards onto a surface
-                // inclined by δ closes the gap by tan δ per metre).
-                c.contact_angle = (-slope).atan();
-                out[side][slot] = c;
+                let g = |k: isize| {
+                    let k = k.clamp(0, self.nw as isize - 1) as usize;
+                    node_gap(k, cj, slot)
+                };
+                let (a, b) = (i as isize, i1 as isize);
+                let (p0, p1) = (g(a), g(b));
+                let m0 = 0.5 * (p1 - g(a - 1));
+                let m1 = 0.5 * (g(b + 1) - p0);
+                let t = tw;
+                let (t2, t3) = (t * t, t * t * t);
+                gap += wr
+                    * ((2.0 * t3 - 3.0 * t2 + 1.0) * p0
+                        + (t3 - 2.0 * t2 + t) * m0
+                        + (-2.0 * t3 + 3.0 * t2) * p1
+                        + (t3 - t2) * m1);
+                slope += wr
+                    * ((6.0 * t2 - 6.0 * t) * p0
+                        + (3.0 * t2 - 4.0 * t + 1.0) * m0
+                        + (-6.0 * t2 + 6.0 * t) * p1
+                        + (3.0 * t2 - 2.0 * t) * m1)
+                    / self.dy;
             }
+            let mut acc = [0.0; 14];
+            for &(ci, cj, wt) in &corners {
+                if wt == 0.0 {
+                    continue;
+                }
+                let v = nodes[ci * self.nr + cj][slot].values();
+                for (a, v) in acc.iter_mut().zip(v) {
+                    *a += wt * v;
+                }
+            }
+            let mut c = Contact::from_values(acc);
+            c.gap = gap;
+            // ∂gap/∂y_s = −tan δ (moving the wheel outwards onto a surface
+            // inclined by δ closes the gap by tan δ per metre).
+            c.contact_angle = (-slope).atan();
+            out[slot] = c;
         }
         Ok(out)
     }

@@ -288,6 +288,14 @@ fn gauge_and_rail_inclination() {
     assert_eq!(t.point(0.0).unwrap().gauge, 1.435);
     assert!((t.point(30.0).unwrap().gauge - 1.440).abs() < 1e-15);
     assert!((t.point(90.0).unwrap().gauge - 1.445).abs() < 1e-15);
+    // The gauge alone is the point's gauge, bit for bit, with the same
+    // errors off the track (the end's slack of 1e-12 relative included).
+    for s in [0.0, 10.0, 20.0, 27.3, 40.0, 99.9, 100.0, 100.0 + 1e-11] {
+        assert_eq!(t.gauge(s).unwrap(), t.point(s).unwrap().gauge, "s = {s}");
+    }
+    for s in [-0.1, 100.1, f64::NAN, f64::INFINITY] {
+        assert!(t.gauge(s).is_err() && t.point(s).is_err(), "s = {s}");
+    }
     assert_eq!(t.rail_inclination(), 1.0 / 40.0);
     assert!(t.clone().with_rail_inclination(-0.1).is_err());
     assert!(t.with_gauge(0.0).is_err());

@@ -296,6 +296,21 @@ fn table_lookup_matches_direct_search() {
         }
     }
     assert!(compared > 60, "{compared}");
+    // One wheel's lookup is that wheel's slots of the both-wheel lookup, bit
+    // for bit (the contact looks each wheel up at its own rail's shift).
+    for k in 0..40 {
+        let (y, roll) = (-3.8e-3 + k as f64 * 0.19e-3, 2e-3 - k as f64 * 0.1e-3);
+        let both = table.lookup_regions(y, roll).unwrap();
+        for side in 0..2 {
+            let one = table.lookup_regions_of(side, y, roll).unwrap();
+            for slot in 0..2 {
+                let (a, b) = (one[slot].values(), both[side][slot].values());
+                let bits = |v: [f64; 14]| v.map(f64::to_bits);
+                assert_eq!(bits(a), bits(b), "y {y}, roll {roll}, side {side}");
+            }
+        }
+    }
+    assert!(table.lookup_regions_of(2, 0.0, 0.0).is_err());
     // rigid functions are stored over the table's lateral range
     let rf = table.rigid_functions();
     assert_eq!(rf.len(), 81);

@@ -33,8 +33,8 @@ impl RailContactGeometry for TableRail<'_> {
             index: 0,
             what: e.to_string(),
         };
-        let sets = self.el.lookup(self.s, d[0]).map_err(geo)?;
-        for (o, c) in out.iter_mut().zip(&sets[self.s.side]) {
+        let slots = self.el.lookup(self.s, d[0]).map_err(geo)?;
+        for (o, c) in out.iter_mut().zip(&slots) {
             *o = match self.el.kinematics(self.s, c, d).map_err(geo)? {
                 Some(k) => RailContact {
                     approach: k.approach,
@@ -117,8 +117,8 @@ impl WheelRailContact {
             forces: sol.contacts.map(|c| c.creep),
             slope: sol.contacts.map(|c| c.lateral_slope),
         };
-        let sets = self.lookup(s, d[0])?;
-        for (i, c) in sets[s.side].iter().enumerate().take(sol.n_contacts) {
+        let slots = self.lookup(s, d[0])?;
+        for (i, c) in slots.iter().enumerate().take(sol.n_contacts) {
             let r = &sol.contacts[i];
             if r.normal_force <= 0.0 {
                 continue;

@@ -147,9 +147,8 @@ impl WheelRailContact {
             .map_err(|e| self.diverged(t, format!("track irregularity at s = {s_ws:.3} m: {e}")))?;
         let widening = b
             .track
-            .point(s_ws)
+            .gauge(s_ws)
             .map_err(|e| self.diverged(t, format!("track at s = {s_ws:.3} m: {e}")))?
-            .gauge
             - b.track.nominal_gauge();
         let rail_shift = [
             (dev.left_lateral + 0.5 * widening, dev.left_vertical),
@@ -204,40 +203,44 @@ impl WheelRailContact {
         Ok((s, frame))
     }
 
-    /// The contact table's region contacts for a side's wheelset position
-    /// with its rail displaced laterally by `rail_dy` (m). With a conicity
+    /// The contact table's region contacts (tread and flange slot) of a
+    /// side's wheel at its wheelset position with its rail displaced
+    /// laterally by `rail_dy` (m). With a conicity
     /// override the table is looked up at the lateral shift y' = s y
     /// (`shift_scale` s) and each contact's rail point is moved by y − y',
     /// so that it lies where the profiles' contact at y' lies relative to
     /// the wheelset (see the element's "Conicity override").
-    pub(super) fn lookup(&self, s: &Side, rail_dy: f64) -> Result<[[Contact; 2]; 2], SimError> {
+    pub(super) fn lookup(&self, s: &Side, rail_dy: f64) -> Result<[Contact; 2], SimError> {
         let y = s.y - rail_dy;
         let scale = s.b.shift_scale;
         if scale != 1.0 {
             let scaled = scale * y;
-            let mut sets = self.lookup_at(s, scaled)?;
-            for c in sets.iter_mut().flatten() {
+            let mut slots = self.lookup_at(s, scaled)?;
+            for c in &mut slots {
                 c.rail_y -= scaled - y;
             }
-            return Ok(sets);
+            return Ok(slots);
         }
         self.lookup_at(s, y)
     }
 
-    /// The contact table's region contacts at the lateral shift `y` (m) and
-    /// the side's roll.
-    fn lookup_at(&self, s: &Side, y: f64) -> Result<[[Contact; 2]; 2], SimError> {
-        s.b.contact.table.lookup_regions(y, s.roll).map_err(|e| {
-            self.diverged(
-                s.ctx.t,
-                format!(
-                    "wheelset out of the contact table ({e}); lateral shift {:.2} mm, roll \
+    /// The contact table's region contacts of the side's wheel at the
+    /// lateral shift `y` (m) and the side's roll.
+    fn lookup_at(&self, s: &Side, y: f64) -> Result<[Contact; 2], SimError> {
+        s.b.contact
+            .table
+            .lookup_regions_of(s.side, y, s.roll)
+            .map_err(|e| {
+                self.diverged(
+                    s.ctx.t,
+                    format!(
+                        "wheelset out of the contact table ({e}); lateral shift {:.2} mm, roll \
                      {:.4} rad: derailment, or enlarge `table`",
-                    y * 1e3,
-                    s.roll
-                ),
-            )
-        })
+                        y * 1e3,
+                        s.roll
+                    ),
+                )
+            })
     }
 
     /// One contact's geometry, frame and creepages with the rail displaced

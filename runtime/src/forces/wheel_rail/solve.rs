@@ -10,7 +10,6 @@ use crate::system::SimError;
 use nalgebra::{Matrix3, Vector3};
 use railmbs_wheelrail::creep::{ContactMode, ContactPatch, CreepForces, Creepages};
 use railmbs_wheelrail::elastic_rail::CreepStart;
-use railmbs_wheelrail::geometry::Contact;
 use railmbs_wheelrail::kalker::KalkerCoefficients;
 
 /// One solved contact.
@@ -149,19 +148,13 @@ impl WheelRailContact {
                 }
             }
             None => {
-                let left = self.lookup(&sides[0], 0.0)?;
-                let right = if sides[1].y == sides[0].y {
-                    left
-                } else {
-                    self.lookup(&sides[1], 0.0)?
-                };
-                let sets: [&[Contact; 2]; 2] = [&left[0], &right[1]];
+                let sets = [self.lookup(&sides[0], 0.0)?, self.lookup(&sides[1], 0.0)?];
                 for (side, geo) in sides.iter().enumerate() {
                     // Normal forces of both contacts first: whether the wheel
                     // is in two-point contact decides the flange contact's
                     // creep law (ContactMode).
                     let mut loaded: [Option<(ContactKinematics, f64, f64)>; 2] = [None, None];
-                    for (slot, c) in loaded.iter_mut().zip(sets[side]) {
+                    for (slot, c) in loaded.iter_mut().zip(&sets[side]) {
                         let Some(k) = self.kinematics(geo, c, [0.0; 2])? else {
                             continue;
                         };
