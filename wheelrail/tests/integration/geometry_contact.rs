@@ -301,11 +301,10 @@ fn table_lookup_matches_direct_search() {
     for k in 0..40 {
         let (y, roll) = (-3.8e-3 + k as f64 * 0.19e-3, 2e-3 - k as f64 * 0.1e-3);
         let both = table.lookup_regions(y, roll).unwrap();
-        for side in 0..2 {
+        for (side, slots) in both.iter().enumerate() {
             let one = table.lookup_regions_of(side, y, roll).unwrap();
-            for slot in 0..2 {
-                let (a, b) = (one[slot].values(), both[side][slot].values());
-                let bits = |v: [f64; 14]| v.map(f64::to_bits);
+            for (a, b) in one.iter().zip(slots) {
+                let bits = |c: &Contact| c.values().map(f64::to_bits);
                 assert_eq!(bits(a), bits(b), "y {y}, roll {roll}, side {side}");
             }
         }
