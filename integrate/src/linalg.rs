@@ -54,7 +54,36 @@ impl DenseLu {
     /// Factorize the matrix filled through [`DenseLu::matrix_mut`] in place.
     /// A pivot that is non-finite or below `n·ε·max|a_ij|` is reported as
     /// singular (the matrix is then numerically rank-deficient).
+    ///
+    /// On x86-64 CPUs with AVX2 (detected at run time) the same code runs
+    /// compiled for AVX2: four lanes per vector instruction instead of
+    /// SSE2's two in the elimination's column updates. The IEEE operations
+    /// and their order are the same (Rust neither contracts nor reassociates
+    /// floating-point arithmetic, and AVX2 brings no fused multiply–add),
+    /// so the factors are bit for bit the same (test
+    /// `avx2_build_is_bit_identical`). Measured on dense random matrices
+    /// (one run, a timing loop of 2·10⁶/n² factorizations): order 42 8 µs
+    /// against 10, 54 (a freight bogie's block) 14 against 19, 114 120
+    /// against 175; orders 18–24 the same.
     pub fn factorize(&mut self) -> Result<(), SingularPivot> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.factorize_avx2() };
+        }
+        self.factorize_lanes()
+    }
+
+    /// [`Self::factorize_lanes`] compiled with AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn factorize_avx2(&mut self) -> Result<(), SingularPivot> {
+        self.factorize_lanes()
+    }
+
+    /// The factorization of [`Self::factorize`], for either build.
+    #[inline(always)]
+    fn factorize_lanes(&mut self) -> Result<(), SingularPivot> {
         let n = self.dim();
         self.valid = false;
         let a = self.lu.as_mut_slice(); // column-major: a[i + j n]
@@ -113,6 +142,8 @@ impl DenseLu {
     }
 
     /// [`DenseLu::solve_in_place`] on a slice of length [`DenseLu::dim`].
+    /// (Not built for AVX2 as the factorization is: measured on orders
+    /// 18–114, the substitutions were no faster with it.)
     pub fn solve_slice(&self, x: &mut [f64]) {
         debug_assert!(self.valid, "solve with an invalid LU factorization");
         let n = self.dim();
@@ -153,6 +184,51 @@ impl DenseLu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The AVX2 build of the factorization gives the portable build's
+    /// numbers bit for bit: matrices of orders 1–70 with
+    /// random entries of mixed magnitude and sign, a fifth of them zero
+    /// (the zero skips), pivoting on every column.
+    #[test]
+    fn avx2_build_is_bit_identical() {
+        #[cfg(target_arch = "x86_64")]
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        // xorshift64*: deterministic, no dependency.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state >> 12;
+            state ^= state << 25;
+            state ^= state >> 27;
+            (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for n in 1..=70 {
+            let mut a = DMatrix::zeros(n, n);
+            for x in a.iter_mut() {
+                let u = next();
+                *x = if u < 0.2 {
+                    0.0
+                } else {
+                    (u - 0.6) * 10f64.powi((next() * 6.0) as i32 - 3)
+                };
+            }
+            for i in 0..n {
+                a[(i, i)] += 1.0;
+            }
+            let (mut fast, mut plain) = (DenseLu::new(n), DenseLu::new(n));
+            fast.matrix_mut().copy_from(&a);
+            plain.matrix_mut().copy_from(&a);
+            let (rf, rp) = (fast.factorize(), plain.factorize_lanes());
+            assert_eq!(rf, rp, "n = {n}");
+            if rf.is_err() {
+                continue;
+            }
+            let bits = |m: &DMatrix<f64>| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast.lu), bits(&plain.lu), "n = {n}");
+            assert_eq!(fast.piv, plain.piv, "n = {n}");
+        }
+    }
 
     #[test]
     fn solves_a_pivoting_system_exactly() {
